@@ -70,7 +70,12 @@ int main(int argc, char **argv) {
     src.text = read_file(input, &src.len);
     Unit u = {0};
     parse_unit(&u, &lib, true);
+    int nlib = u.pous.n;
     parse_unit(&u, &src, false);
+    if (u.pous.n == nlib && !u.types.n && !u.configs.n) {
+        Loc at = {&src, 1, 1};
+        fatal_at(at, "nothing to compile: no FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
+    }
     sema(&u);
     if (error_count) return 1;
     struct stat st;

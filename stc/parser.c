@@ -542,7 +542,15 @@ static bool var_block(P *p, Vec *out, bool global_ok) {
         else if (accept_kw(p, "NON_RETAIN")) retain = false;
         else break;
     }
+    int first = out->n;
     var_decls(p, out, cls, constant, retain, t, "END_VAR");
+    /* matiec wants located variables in VAR blocks of their own */
+    for (int i = first + 1; i < out->n; i++) {
+        VarDecl *a = out->v[first], *d = out->v[i];
+        if (!a->location != !d->location)
+            fatal_at(d->loc, "'%s': located and unlocated variables cannot share a VAR block; give the %s ones a block of their own",
+                     d->name, a->location ? "unlocated" : "located");
+    }
     expect_end(p, t, "VAR", "END_VAR");
     return true;
 }

@@ -505,7 +505,7 @@ static Type *check_typed(Ctx *c, Node *n, Type *want) {
     Type *ct = canon(t);
     if (l->kind == N_INT) {
         l->ty = ty_prim[T_LITINT];
-        if (is_real(ct)) { l->kind = N_REAL; l->rval = l->neg ? -(double)l->ival : (double)l->ival; l->ty = t; return t; }
+        if (is_real(ct)) { error_at(n->start, "malformed %s literal: write %s#%s%llu.0", t->name, n->name, l->neg ? "-" : "", (unsigned long long)l->ival); return err_type(); }
         if (!(is_int(ct) || is_bit(ct) || ct->kind == T_BOOL)) {
             error_at(n->start, "malformed %s literal", t->name);
             return err_type();

@@ -36,6 +36,9 @@ void error_at(Loc loc, const char *f, ...) __attribute__((format(printf, 2, 3)))
 /* Same, then exit(1). */
 _Noreturn void fatal_at(Loc loc, const char *f, ...) __attribute__((format(printf, 2, 3)));
 extern int error_count;
+/* When set, fatal errors jump here instead of exiting (for embedding and fuzzing). */
+#include <setjmp.h>
+extern jmp_buf *stc_error_jmp;
 #define MAX_ERRORS 20
 
 /* ---- tokens (lexer.c) ---- */

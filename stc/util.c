@@ -2,12 +2,14 @@
 #include "stc.h"
 
 #include <ctype.h>
+#include <setjmp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 int error_count;
+jmp_buf *stc_error_jmp;
 
 void *xalloc(size_t n) {
     void *p = calloc(1, n ? n : 1);
@@ -106,16 +108,26 @@ static void verror(Loc loc, const char *f, va_list ap) {
     fputc('\n', stderr);
     int len;
     const char *s = line_of(loc, &len);
+    int col = loc.col - 1;
+    if (len > 160) {            /* a long line: show 160 columns around the spot */
+        int from = col > 80 ? col - 80 : 0;
+        if (from > len) from = len;
+        s += from;
+        len -= from;
+        col -= from;
+        if (len > 160) len = 160;
+    }
     fputs("  ", stderr);
     for (int i = 0; i < len; i++) {
         unsigned char ch = (unsigned char)s[i];
         fputc(ch == '\t' || ch >= 0x20 ? ch : ' ', stderr);
     }
     fputs("\n  ", stderr);
-    for (int i = 0; i < loc.col - 1 && i < len; i++) fputc(s[i] == '\t' ? '\t' : ' ', stderr);
+    for (int i = 0; i < col && i < len; i++) fputc(s[i] == '\t' ? '\t' : ' ', stderr);
     fputs("^\n", stderr);
     if (error_count >= MAX_ERRORS) {
         fprintf(stderr, "stc: too many errors, stopping\n");
+        if (stc_error_jmp) longjmp(*stc_error_jmp, 1);
         exit(1);
     }
 }
@@ -132,5 +144,6 @@ void fatal_at(Loc loc, const char *f, ...) {
     va_start(ap, f);
     verror(loc, f, ap);
     va_end(ap);
+    if (stc_error_jmp) longjmp(*stc_error_jmp, 1);
     exit(1);
 }
