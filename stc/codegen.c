@@ -887,6 +887,7 @@ static void emit_fb(G *g, Pou *p) {
 static const char *g_outdir;
 
 static void write_file(const char *name, Buf *b) {
+    if (!g_outdir) return;
     char *path = fmt("%s/%s", g_outdir, name);
     FILE *f = fopen(path, "w");
     if (!f) { fprintf(stderr, "stc: cannot write %s: %s\n", path, strerror(errno)); exit(1); }

@@ -1086,12 +1086,18 @@ static Type *check(Ctx *c, Node *n, Type *want) {
         n->ty = t;
         if (want && !is_err(want) && !is_lit(want)) {
             Type *cw = canon(want);
-            if (is_int(cw) || is_bit(cw) || cw->kind == T_BOOL) { lit_fits(n, want, true); return n->ty; }
+            if (is_int(cw) || is_bit(cw) || cw->kind == T_BOOL) {
+                if (!lit_fits(n, want, true)) n->ty = err_type();
+                return n->ty;
+            }
         }
         return t;
     case N_REAL:
         n->ty = ty_prim[T_LITREAL];
-        if (want && is_real(want) && !is_lit(want)) { lit_fits(n, want, true); return n->ty; }
+        if (want && is_real(want) && !is_lit(want)) {
+            if (!lit_fits(n, want, true)) n->ty = err_type();
+            return n->ty;
+        }
         return n->ty;
     case N_BOOL: t = ty_prim[T_BOOL]; break;
     case N_STRING: t = ty_prim[T_STRING]; break;
