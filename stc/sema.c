@@ -212,7 +212,9 @@ static Type *array_type(Ctx *c, Type *elem, Dim *dims, int nd, const char *decln
     int64_t count = 1;
     for (int k = 0; k < nd; k++) {
         int64_t n = dims[k].hi - dims[k].lo + 1;
-        buf_printf(&b, "_%lld", (long long)n);
+        if (dims[k].lo == 0) buf_printf(&b, "_%lld", (long long)n);
+        else buf_printf(&b, "_%s%lld_%s%lld", dims[k].lo < 0 ? "m" : "", (long long)llabs(dims[k].lo),
+                        dims[k].hi < 0 ? "m" : "", (long long)llabs(dims[k].hi));
         if (n > 0 && count <= (INT64_C(1) << 40) / n) count *= n;
         else count = INT64_C(1) << 41;
     }
