@@ -863,7 +863,6 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
             error_at(call->loc, "missing parameter '%s' for '%s'", s->name, p->name);
     }
     (void)is_fb;
-    free(given);
 }
 
 /* ---- builtin functions ---- */
@@ -925,7 +924,6 @@ static bool order_builtin_args(Node *n, int id) {
         if (!ord[i]) { error_at(n->loc, "missing parameter for '%s'", n->name); return false; }
         n->list.v[i] = ord[i];
     }
-    free(ord);
     return true;
 }
 
@@ -1270,7 +1268,6 @@ static void check_stmt(Ctx *c, Node *s) {
             }
             check_stmts(c, &item->list2);
         }
-        free(seen.v);
         if (s->els) check_stmts(c, &s->els->list);
         return;
     }
