@@ -589,7 +589,8 @@ static void fb_call(G *g, Buf *b, Node *call, int ind) {
     int id = ++g->tmp;
     indent(b, ind);
     buf_printf(b, "{ %s *__fb%d = &", p->type->cname, id);
-    var_ref(g, b, inst);
+    if (call->lhs) { buf_put(b, "("); expr(g, b, call->lhs); buf_put(b, ")"); }
+    else var_ref(g, b, inst);
     buf_put(b, ";\n");
     for (int i = 0; i < call->list.n; i++) {
         Node *a = call->list.v[i];
@@ -630,7 +631,7 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         buf_put(b, ";\n");
         return;
     case S_CALL:
-        if (s->lhs->sym && !s->lhs->builtin && s->lhs->callee && s->lhs->callee->kind != POU_FUNCTION) {
+        if ((s->lhs->sym || s->lhs->lhs) && !s->lhs->builtin && s->lhs->callee && s->lhs->callee->kind != POU_FUNCTION) {
             fb_call(g, b, s->lhs, ind);
             return;
         }

@@ -691,6 +691,18 @@ static Node *statement(P *p) {
             expect_p(p, ";");
             return n;
         }
+        if ((target->kind == N_INDEX || target->kind == N_MEMBER) && is_p(cur(p), "(")) {
+            /* an instance reached through an array or a member: a[i](...) */
+            Token *open = next(p);
+            Node *call = new_node(N_CALL, open);
+            call->start = target->start;
+            call->loc = target->start;
+            call->lhs = target;
+            call->name = "instance";
+            call->uname = "";
+            call_args(p, call);
+            target = call;
+        }
         if (target->kind == N_CALL) {
             n = new_node(S_CALL, t);
             n->lhs = target;

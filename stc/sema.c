@@ -746,6 +746,15 @@ static void check_writable(Ctx *c, Node *n) {
 }
 
 static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
+    if (n->lhs) {      /* a[i](...): the instance is an expression */
+        Type *it = check(c, n->lhs, NULL);
+        if (is_err(it)) return it;
+        if (canon(it)->kind != T_FB) { error_at(n->lhs->start, "this is not a function block instance, it is %s", type_name(it)); return err_type(); }
+        n->callee = canon(it)->pou;
+        n->name = n->callee->name;
+        check_call_args(c, n, n->callee, true);
+        return ty_prim[T_VOID];
+    }
     Sym *v = lookup_var(c, n->uname);
     if (v && v->kind == SK_VAR) {
         Type *t = canon(v->type);
