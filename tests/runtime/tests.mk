@@ -28,3 +28,30 @@ test-runtime-units: $(RT_UNIT_BINS)
 	  TMPDIR=$(abspath $(RT_T)) mk/suite.sh $(RESULTS) runtime-$$u-san $(RT_T)/$$u-san || rc=1; \
 	done; exit $$rc
 TESTS += test-runtime-units
+
+# image binding: the real compiler's output of st/iotest.st
+$(eval $(call plcrt_program,rt_iotest,tests/runtime/st/iotest.st))
+$(RT_T)/check_image: tests/runtime/check_image.c $(BUILD)/plc/rt_iotest/program.o $(PLCRT_B)/plc_image.o $(PLCRT_B)/program.o
+	@mkdir -p $(@D)
+	$(CC) $(PLCRT_CFLAGS) -o $@ $^ $(RT_CHECK_LIBS)
+
+.PHONY: test-runtime-image
+test-runtime-image: $(RT_T)/check_image $(STC)
+	@rc=0; mk/suite.sh $(RESULTS) runtime-image $(RT_T)/check_image || rc=1; \
+	mk/suite.sh $(RESULTS) runtime-located-outside tests/runtime/located_outside.sh \
+	  $(STC) $(STC_INC) $(RT_T)/outside $(CC) $(PLC_GEN_CFLAGS) || rc=1; exit $$rc
+TESTS += test-runtime-image
+
+# integration: libmodbus's own random-test-client, pointed at our test port
+RT_PORT := 15020
+RT_MB_EXAMPLES := /usr/share/doc/libmodbus-dev/examples
+$(RT_T)/random-test-client: $(RT_MB_EXAMPLES)/random-test-client.c
+	@mkdir -p $(@D)
+	sed 's/1502)/$(RT_PORT))/' $< > $@.c
+	$(CC) -O2 -w -o $@ $@.c $(shell pkg-config --cflags --libs libmodbus)
+
+.PHONY: test-runtime-integration
+test-runtime-integration: $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client
+	@mk/suite.sh $(RESULTS) runtime-integration python3 tests/runtime/test_plcrt.py \
+	  $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client $(RT_PORT) $(abspath $(RT_T))/integration
+TESTS += test-runtime-integration
