@@ -27,11 +27,11 @@
 #define PLC_AREA_ML plc_img.ml
 
 /* a, b, c: the address parts padded with -1; c must stay -1. */
-#define PLC_OK_X(a, b, c) ((a) >= 0 && (a) < PLC_IMG_X && (b) >= 0 && (b) < 8 && (c) == -1)
-#define PLC_OK_B(a, b, c) ((a) >= 0 && (a) < PLC_IMG_B && (b) == -1)
-#define PLC_OK_W(a, b, c) ((a) >= 0 && (a) < PLC_IMG_W && (b) == -1)
-#define PLC_OK_D(a, b, c) ((a) >= 0 && (a) < PLC_IMG_D && (b) == -1)
-#define PLC_OK_L(a, b, c) ((a) >= 0 && (a) < PLC_IMG_L && (b) == -1)
+#define PLC_OK_X(a, b, c, ...) ((a) >= 0 && (a) < PLC_IMG_X && (b) >= 0 && (b) < 8 && (c) == -1)
+#define PLC_OK_B(a, b, ...) ((a) >= 0 && (a) < PLC_IMG_B && (b) == -1)
+#define PLC_OK_W(a, b, ...) ((a) >= 0 && (a) < PLC_IMG_W && (b) == -1)
+#define PLC_OK_D(a, b, ...) ((a) >= 0 && (a) < PLC_IMG_D && (b) == -1)
+#define PLC_OK_L(a, b, ...) ((a) >= 0 && (a) < PLC_IMG_L && (b) == -1)
 #define PLC_OFF_X(a, b, ...) ((a) * 8 + (b))
 #define PLC_OFF_B(a, ...) (a)
 #define PLC_OFF_W(a, ...) ((a) * 2)

@@ -7,7 +7,7 @@ PLCRT_CFLAGS := $(CFLAGS) -I plc_runtime $(shell pkg-config --cflags libmodbus 2
 PLCRT_LIBS := -linih -lmodbus -lpthread -lm
 PLCRT_CORE := plc_image log stats config program mbmap mbserver retain scan \
               io_none io_sim io_backends
-PLCRT_OBJ  := $(PLCRT_CORE:%=$(PLCRT_B)/%.o) $(PLCRT_B)/plant.o
+PLCRT_OBJ  := $(PLCRT_CORE:%=$(PLCRT_B)/%.o) $(C_BLOCKS_OBJ)
 PLCRT_MAIN := $(PLCRT_B)/main.o
 PLCRT_HDRS := $(wildcard plc_runtime/*.h) c_blocks/plant.h
 # Flags for the compiler's generated C (override to build another
@@ -17,9 +17,6 @@ PLC_GEN_CFLAGS ?= $(CFLAGS)
 $(PLCRT_B)/%.o: plc_runtime/%.c $(PLCRT_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(PLCRT_CFLAGS) -c $< -o $@
-$(PLCRT_B)/plant.o: c_blocks/plant.c c_blocks/plant.h
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) -c $< -o $@
 
 # $(call plcrt_program,NAME,ST_FILES): the ST files are joined in order
 # (c_blocks/*.st declarations first when used) and compiled with $(STC).

@@ -18,7 +18,8 @@ endef
 $(eval $(call rt_unit,check_mbmap,$(RT_SRC_MAP)))
 $(eval $(call rt_unit,check_config,$(RT_SRC_CFG)))
 $(eval $(call rt_unit,check_retain,$(RT_SRC_RET)))
-RT_UNITS := check_mbmap check_config check_retain
+$(eval $(call rt_unit,check_plant,c_blocks/plant.c))
+RT_UNITS := check_mbmap check_config check_retain check_plant
 RT_UNIT_BINS := $(foreach u,$(RT_UNITS),$(RT_T)/$(u) $(RT_T)/$(u)-san)
 
 .PHONY: test-runtime-units
@@ -35,9 +36,16 @@ $(RT_T)/check_image: tests/runtime/check_image.c $(BUILD)/plc/rt_iotest/program.
 	@mkdir -p $(@D)
 	$(CC) $(PLCRT_CFLAGS) -o $@ $^ $(RT_CHECK_LIBS)
 
+# the plant as an ST block (c_blocks/sim_axis.st) beside the sim backend
+$(eval $(call plcrt_program,rt_simblock,$(C_BLOCKS_ST) tests/runtime/st/simblock.st))
+$(RT_T)/check_sim_block: tests/runtime/check_sim_block.c $(BUILD)/plc/rt_simblock/program.o $(PLCRT_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(PLCRT_CFLAGS) -o $@ $^ $(RT_CHECK_LIBS) $(PLCRT_LIBS)
+
 .PHONY: test-runtime-image
-test-runtime-image: $(RT_T)/check_image $(STC)
+test-runtime-image: $(RT_T)/check_image $(RT_T)/check_sim_block $(STC)
 	@rc=0; mk/suite.sh $(RESULTS) runtime-image $(RT_T)/check_image || rc=1; \
+	mk/suite.sh $(RESULTS) runtime-sim-block $(RT_T)/check_sim_block || rc=1; \
 	mk/suite.sh $(RESULTS) runtime-located-outside tests/runtime/located_outside.sh \
 	  $(STC) $(STC_INC) $(RT_T)/outside $(CC) $(PLC_GEN_CFLAGS) || rc=1; exit $$rc
 TESTS += test-runtime-image
