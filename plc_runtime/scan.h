@@ -36,6 +36,8 @@ typedef struct scan {
 } scan;
 
 void *scan_thread(void *arg);
+/* One cycle: inputs, Modbus writes, program, publish, outputs. */
+void scan_cycle(scan *s, uint64_t plc_ns, unsigned long tick);
 uint64_t scan_now_ns(void);
 /* Copy samples[] atomically with respect to cycles: through the scan when it
 ** runs (waiting up to timeout_ms), directly otherwise. 0, or -1 on timeout. */
