@@ -43,7 +43,7 @@ static int consistent(uint64_t g)
 
 static void setup(void)
 {
-    snprintf(dir, sizeof dir, "%s/retain-XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    snprintf(dir, sizeof dir, "%s/retain-XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : P_tmpdir);
     ck_assert_ptr_nonnull(mkdtemp(dir));
     snprintf(file, sizeof file, "%s/plc.retain", dir);
     vars();
