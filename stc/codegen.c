@@ -297,7 +297,13 @@ static void conversion(G *g, Buf *b, Node *n) {
     Type *from = ct(n->conv_from), *to = ct(n->ty);
     Node *a = arg(n, 0);
     bool tf = from->kind >= T_TIME && from->kind <= T_DT, tt = to->kind >= T_TIME && to->kind <= T_DT;
-    if (tf && tt) { buf_printf(b, "((%s)", cty(n->ty)); expr(g, b, a); buf_put(b, ")"); return; }
+    if (tf && tt) {
+        const char *f = from->kind == T_DT && to->kind == T_TOD ? "__dt_to_tod" : from->kind == T_DT && to->kind == T_DATE ? "__dt_to_date" : "";
+        buf_printf(b, "%s(", f);
+        expr(g, b, a);
+        buf_put(b, ")");
+        return;
+    }
     if (tf) {
         if (is_real(to)) { buf_printf(b, "((%s)__time_to_real(", cty(n->ty)); expr(g, b, a); buf_put(b, "))"); }
         else if (to->kind == T_BOOL) { buf_put(b, "(__time_to_int("); expr(g, b, a); buf_put(b, ") != 0)"); }
@@ -887,6 +893,7 @@ static void emit_fb(G *g, Pou *p) {
 static const char *g_outdir;
 
 static void write_file(const char *name, Buf *b) {
+    if (!g_outdir) return;
     char *path = fmt("%s/%s", g_outdir, name);
     FILE *f = fopen(path, "w");
     if (!f) { fprintf(stderr, "stc: cannot write %s: %s\n", path, strerror(errno)); exit(1); }
@@ -951,6 +958,8 @@ int codegen(Unit *u, const char *outdir) {
     buf_put(&g.h, "#ifndef __POUS_H\n#define __POUS_H\n\n#include \"iec_std_lib.h\"\n\n");
     buf_put(&g.c, banner);
     buf_put(&g.c, "#include \"POUS.h\"\n\n");
+    /* ST may compare a variable with itself (x = x is FALSE for a NaN) */
+    buf_put(&g.c, "#pragma GCC diagnostic ignored \"-Wtautological-compare\"\n\n");
     for (int i = 0; i < u->pragmas.n; i++) buf_printf(&g.c, "%s\n", ((Token *)u->pragmas.v[i])->sval);
     /* types in dependency order */
     for (int i = 0; i < u->types.n; i++) {

@@ -5,7 +5,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #ifndef STC_INCLUDE_DIR
 #define STC_INCLUDE_DIR "/usr/local/share/stc/include"
@@ -65,23 +64,7 @@ int main(int argc, char **argv) {
     }
     if (!input) { usage(stderr); return 1; }
 
-    Source lib = {"<standard library>", stdlib_st, strlen(stdlib_st)};
     Source src = {input, NULL, 0};
     src.text = read_file(input, &src.len);
-    Unit u = {0};
-    parse_unit(&u, &lib, true);
-    int nlib = u.pous.n;
-    parse_unit(&u, &src, false);
-    if (u.pous.n == nlib && !u.types.n && !u.configs.n) {
-        Loc at = {&src, 1, 1};
-        fatal_at(at, "nothing to compile: no FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
-    }
-    sema(&u);
-    if (error_count) return 1;
-    struct stat st;
-    if (stat(outdir, &st) != 0 && mkdir(outdir, 0777) != 0) {
-        fprintf(stderr, "stc: cannot create '%s': %s\n", outdir, strerror(errno));
-        return 1;
-    }
-    return codegen(&u, outdir) ? 1 : 0;
+    return stc_compile(&src, outdir);
 }

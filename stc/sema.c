@@ -212,7 +212,9 @@ static Type *array_type(Ctx *c, Type *elem, Dim *dims, int nd, const char *decln
     int64_t count = 1;
     for (int k = 0; k < nd; k++) {
         int64_t n = dims[k].hi - dims[k].lo + 1;
-        buf_printf(&b, "_%lld", (long long)n);
+        if (dims[k].lo == 0) buf_printf(&b, "_%lld", (long long)n);
+        else buf_printf(&b, "_%s%lld_%s%lld", dims[k].lo < 0 ? "m" : "", (long long)llabs(dims[k].lo),
+                        dims[k].hi < 0 ? "m" : "", (long long)llabs(dims[k].hi));
         if (n > 0 && count <= (INT64_C(1) << 40) / n) count *= n;
         else count = INT64_C(1) << 41;
     }
@@ -1086,12 +1088,18 @@ static Type *check(Ctx *c, Node *n, Type *want) {
         n->ty = t;
         if (want && !is_err(want) && !is_lit(want)) {
             Type *cw = canon(want);
-            if (is_int(cw) || is_bit(cw) || cw->kind == T_BOOL) { lit_fits(n, want, true); return n->ty; }
+            if (is_int(cw) || is_bit(cw) || cw->kind == T_BOOL) {
+                if (!lit_fits(n, want, true)) n->ty = err_type();
+                return n->ty;
+            }
         }
         return t;
     case N_REAL:
         n->ty = ty_prim[T_LITREAL];
-        if (want && is_real(want) && !is_lit(want)) { lit_fits(n, want, true); return n->ty; }
+        if (want && is_real(want) && !is_lit(want)) {
+            if (!lit_fits(n, want, true)) n->ty = err_type();
+            return n->ty;
+        }
         return n->ty;
     case N_BOOL: t = ty_prim[T_BOOL]; break;
     case N_STRING: t = ty_prim[T_STRING]; break;

@@ -268,7 +268,10 @@ const char *type_name(const Type *t);
 void sema(Unit *u);
 
 /* ---- code generation (codegen.c) ---- */
-int codegen(Unit *u, const char *outdir);
+int codegen(Unit *u, const char *outdir);   /* outdir NULL: generate, write nothing */
+
+/* ---- the whole pipeline (compile.c): 0 on success, 1 after errors ---- */
+int stc_compile(const Source *src, const char *outdir);
 
 Type *canon(Type *t);              /* through aliases and subranges */
 
