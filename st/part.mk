@@ -11,4 +11,4 @@ $(ST_LIB): $(ST_LIB_SRC)
 	@mkdir -p $(@D)
 	cat $(ST_LIB_SRC) > $@
 
--include tests/epicpos/epicpos.mk
+include tests/epicpos/epicpos.mk
