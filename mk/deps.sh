@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 list() { cat "$@" 2>/dev/null | sed 's/#.*//' | tr -s ' \t' '\n' | sed '/^$/d' | sort -u; }
 
 missing_deb=()
-for p in $(list */deps.debian); do
+for p in $(list */deps.debian */*/deps.debian); do
     dpkg-query -W -f='${Status}\n' "$p" 2>/dev/null | grep -q '^install ok installed' || missing_deb+=("$p")
 done
 if [ ${#missing_deb[@]} -gt 0 ]; then
@@ -27,7 +27,7 @@ fi
 
 # Python packages, for the python3 first on PATH (the one the tests run).
 missing_pip=()
-for p in $(list */deps.pip); do
+for p in $(list */deps.pip */*/deps.pip); do
     # an entry is "pip-requirement[:import-name]"
     name=${p%%:*}; mod=${p##*:}; mod=${mod%%[=<>]*}
     python3 -c "import $mod" 2>/dev/null || missing_pip+=("$name")

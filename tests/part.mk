@@ -1,0 +1,18 @@
+# Test suites of tests/. Each part of the test tree adds its own block.
+
+# ---- stc: ST programs run tick by tick, error diagnostics, robustness ----
+STC_TESTS := $(BUILD)/tests/stc
+
+test-stc-run: $(STC)
+	@mkdir -p $(STC_TESTS)
+	@mk/suite.sh $(RESULTS) stc-run env STC="$(STC)" STC_INC="$(STC_INC)" \
+	    CC="$(CC)" CFLAGS="$(CFLAGS)" SAN="$(SAN)" \
+	    tests/stc/run.sh $(STC_TESTS)/run $(sort $(wildcard tests/stc/run/*.st))
+
+test-stc-errors: $(STC)
+	@mkdir -p $(STC_TESTS)
+	@mk/suite.sh $(RESULTS) stc-errors env STC="$(STC)" \
+	    tests/stc/errors.sh $(STC_TESTS)/errors $(sort $(wildcard tests/stc/errors/*.st))
+
+TESTS += test-stc-run test-stc-errors
+.PHONY: test-stc-run test-stc-errors
