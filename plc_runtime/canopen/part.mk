@@ -1,0 +1,33 @@
+# CANopen master: protocol core (frame level), SocketCAN link, unit tests,
+# real-bus tests in User-Mode Linux, benchmarks.
+
+CO_DIR   := plc_runtime/canopen
+CO_BUILD := $(BUILD)/canopen
+CO_SRC   := $(wildcard $(CO_DIR)/co_*.c)
+CO_HDR   := $(wildcard $(CO_DIR)/*.h)
+CO_OBJ   := $(CO_SRC:$(CO_DIR)/%.c=$(CO_BUILD)/%.o)
+CO_LIB   := $(CO_BUILD)/libcanopen.a
+CO_TSRC  := $(wildcard tests/canopen/test_*.c)
+
+$(CO_BUILD)/%.o: $(CO_DIR)/%.c $(CO_HDR)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -c $< -o $@
+
+$(CO_LIB): $(CO_OBJ)
+	rm -f $@ && ar rcs $@ $^
+
+$(CO_BUILD)/test_co: $(CO_TSRC) $(CO_LIB) $(CO_HDR)
+	$(CC) $(CFLAGS) -I$(CO_DIR) $(CO_TSRC) $(CO_LIB) -o $@ $$(pkg-config --cflags --libs check)
+
+$(CO_BUILD)/test_co_san: $(CO_TSRC) $(CO_SRC) $(CO_HDR)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $(SAN) -I$(CO_DIR) $(CO_TSRC) $(CO_SRC) -o $@ $$(pkg-config --cflags --libs check)
+
+ALL += $(CO_LIB) $(CO_BUILD)/test_co $(CO_BUILD)/test_co_san
+
+.PHONY: canopen_unit canopen_unit_san
+canopen_unit: $(CO_BUILD)/test_co
+	@mk/suite.sh $(RESULTS) canopen_unit $<
+canopen_unit_san: $(CO_BUILD)/test_co_san
+	@mk/suite.sh $(RESULTS) canopen_unit_san $<
+TESTS += canopen_unit canopen_unit_san
