@@ -31,3 +31,14 @@ canopen_unit: $(CO_BUILD)/test_co
 canopen_unit_san: $(CO_BUILD)/test_co_san
 	@mk/suite.sh $(RESULTS) canopen_unit_san $<
 TESTS += canopen_unit canopen_unit_san
+
+# stand-alone master on the core, for the bus tests and the benchmarks
+$(CO_BUILD)/co_testmaster: tests/canopen/co_testmaster.c $(CO_LIB) $(CO_HDR)
+	$(CC) $(CFLAGS) -I$(CO_DIR) $< $(CO_LIB) -o $@
+ALL += $(CO_BUILD)/co_testmaster
+
+# real-bus tests: User-Mode Linux with vcan0, python-canopen slaves
+.PHONY: canopen_bus
+canopen_bus: $(CO_BUILD)/co_testmaster
+	@mk/suite.sh $(RESULTS) canopen_bus tests/canopen/run_bus.sh $(CO_BUILD)
+TESTS += canopen_bus
