@@ -42,3 +42,12 @@ ALL += $(CO_BUILD)/co_testmaster
 canopen_bus: $(CO_BUILD)/co_testmaster
 	@mk/suite.sh $(RESULTS) canopen_bus tests/canopen/run_bus.sh $(CO_BUILD)
 TESTS += canopen_bus
+
+# the plcrt backend `canopen` (built once the runtime's interface is there);
+# plcrt links $(CO_BACKEND)
+ifneq ($(wildcard plc_runtime/io_backend.h),)
+$(CO_BUILD)/io_canopen.o: $(CO_DIR)/io_canopen.c $(CO_HDR) $(wildcard plc_runtime/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -Iplc_runtime -I$(CO_DIR) -c $< -o $@
+CO_BACKEND := $(CO_BUILD)/io_canopen.o $(CO_LIB)
+endif
