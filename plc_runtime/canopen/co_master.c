@@ -292,6 +292,8 @@ void co_master_rx(co_master *m, const co_frame *f, co_time now)
         return;
     co_frame out;
     if (fc == CO_FC_HB) {
+        int prev_op = n->was_op;
+        n->was_op = f->len >= 1 && n->phase == CO_PH_RUN && (f->data[0] & 0x7F) == CO_ST_OPERATIONAL;
         switch (co_hb_rx(&n->hb, f, now)) {
         case CO_HB_BOOTUP:
             bootup(m, n, now);
@@ -304,7 +306,8 @@ void co_master_rx(co_master *m, const co_frame *f, co_time now)
             }
             break;
         case CO_HB_STATE:
-            if (n->phase == CO_PH_RUN && n->hb.state != CO_ST_OPERATIONAL)
+            /* a heartbeat sent before our start command arrived is no news */
+            if (n->phase == CO_PH_RUN && n->hb.state != CO_ST_OPERATIONAL && prev_op)
                 logf_(m, 1, "node %u: left operational, now %s", n->cfg.id,
                       co_nmt_state_name(n->hb.state));
             break;

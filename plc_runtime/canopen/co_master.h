@@ -55,6 +55,7 @@ typedef struct co_node {
     uint8_t rx[CO_PDO_PER_NODE][8]; /* last TPDO payloads */
     uint8_t tx[CO_PDO_PER_NODE][8]; /* RPDO payloads to send */
     uint8_t rx_new;                 /* bit per TPDO received since last take */
+    uint8_t was_op;                 /* last heartbeat said operational */
     /* diagnostics */
     uint32_t device_type;           /* as read */
     uint32_t starts, unexpected_boot, hb_lost, emcy_count, sdo_errors;

@@ -74,6 +74,29 @@ int co_can_send(int fd, const co_frame *f)
     return -1;
 }
 
+int co_can_send_many(int fd, const co_frame *f, int n)
+{
+    struct can_frame cf[64];
+    struct iovec iov[64];
+    struct mmsghdr mh[64];
+    if (n > 64)
+        n = 64;
+    memset(cf, 0, sizeof cf[0] * (size_t)n);
+    memset(mh, 0, sizeof mh[0] * (size_t)n);
+    for (int i = 0; i < n; i++) {
+        cf[i].can_id = (f[i].id & CAN_SFF_MASK) | (f[i].rtr ? CAN_RTR_FLAG : 0);
+        cf[i].can_dlc = f[i].len > 8 ? 8 : f[i].len;
+        memcpy(cf[i].data, f[i].data, cf[i].can_dlc);
+        iov[i] = (struct iovec){ &cf[i], sizeof cf[i] };
+        mh[i].msg_hdr.msg_iov = &iov[i];
+        mh[i].msg_hdr.msg_iovlen = 1;
+    }
+    int r = sendmmsg(fd, mh, (unsigned)n, 0);
+    if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS))
+        return 0;
+    return r;
+}
+
 int co_can_recv(int fd, co_frame *f)
 {
     struct can_frame cf;

@@ -11,6 +11,9 @@
 int co_can_open(const char *ifname, char *err, size_t errlen);
 /* 1 sent, 0 would block (queue full), -1 error (errno set: ENETDOWN...). */
 int co_can_send(int fd, const co_frame *f);
+/* Send up to n frames with one system call (sendmmsg); returns how many
+ * went out (0 if the queue is full), -1 on error (errno set). */
+int co_can_send_many(int fd, const co_frame *f, int n);
 /* 1 a frame in *f (error frames carry CO_ERR_FLAG), 0 nothing, -1 error. */
 int co_can_recv(int fd, co_frame *f);
 /* 1 if the interface is up and running, 0 if not, -1 if it is gone. */

@@ -51,3 +51,17 @@ $(CO_BUILD)/io_canopen.o: $(CO_DIR)/io_canopen.c $(CO_HDR) $(wildcard plc_runtim
 	$(CC) $(CFLAGS) -Iplc_runtime -I$(CO_DIR) -c $< -o $@
 CO_BACKEND := $(CO_BUILD)/io_canopen.o $(CO_LIB)
 endif
+
+# benchmarks: SYNC-to-RPDO latency, PDO throughput, bus load (bench/canopen)
+$(CO_BUILD)/co_bench: bench/canopen/co_bench.c
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $< -o $@ -lm
+ALL += $(CO_BUILD)/co_bench
+.PHONY: bench_canopen
+bench_canopen: $(CO_BUILD)/co_bench $(CO_BUILD)/co_testmaster
+	@bench/canopen/run.sh $(CO_BUILD)
+BENCHES += bench_canopen
+$(CO_BUILD)/co_core_bench: bench/canopen/co_core_bench.c $(CO_LIB) $(CO_HDR)
+	$(CC) $(CFLAGS) -I$(CO_DIR) $< $(CO_LIB) -o $@
+ALL += $(CO_BUILD)/co_core_bench
+bench_canopen: $(CO_BUILD)/co_core_bench
