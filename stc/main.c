@@ -1,0 +1,87 @@
+/* stc command line: stc [-I libdir] [-T outdir] file.st, like matiec's iec2c. */
+#include "stc.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#ifndef STC_INCLUDE_DIR
+#define STC_INCLUDE_DIR "/usr/local/share/stc/include"
+#endif
+
+static void usage(FILE *f) {
+    fputs("usage: stc [-I libdir] [-T outdir] file.st\n"
+          "       stc --version | --include-dir | --help\n"
+          "Compiles IEC 61131-3 Structured Text to C, in matiec's file layout:\n"
+          "POUS.c, POUS.h, <Config>.c/.h, <Resource>.c, LOCATED_VARIABLES.h and\n"
+          "VARIABLES.csv in outdir (default: the current directory).\n"
+          "Build the output with: cc -I \"$(stc --include-dir)\" -c <Config>.c <Resource>.c\n"
+          "  -I libdir  accepted for iec2c compatibility; the standard library is built in\n"
+          "  -T outdir  where to write the C files (created if missing)\n", f);
+}
+
+static char *read_file(const char *path, size_t *len) {
+    FILE *f = fopen(path, "rb");
+    if (!f) { fprintf(stderr, "stc: cannot open '%s': %s\n", path, strerror(errno)); exit(1); }
+    Buf b = {0};
+    buf_put(&b, "");
+    char chunk[65536];
+    size_t n;
+    while ((n = fread(chunk, 1, sizeof chunk, f)) > 0) {
+        if (b.n + n > 64u * 1024 * 1024) { fprintf(stderr, "stc: '%s' is too large\n", path); exit(1); }
+        char tmp[2] = {0, 0};
+        for (size_t i = 0; i < n; i++) {   /* keep NUL bytes: the lexer reports them */
+            tmp[0] = chunk[i];
+            if (chunk[i]) buf_put(&b, tmp);
+            else { buf_put(&b, " "); b.s[b.n - 1] = 0; }
+        }
+    }
+    if (ferror(f)) { fprintf(stderr, "stc: cannot read '%s': %s\n", path, strerror(errno)); exit(1); }
+    fclose(f);
+    *len = b.n;
+    return b.s;
+}
+
+int main(int argc, char **argv) {
+    const char *outdir = ".", *input = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--version")) { printf("stc %s\n", STC_VERSION); return 0; }
+        if (!strcmp(a, "--include-dir")) { printf("%s\n", STC_INCLUDE_DIR); return 0; }
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
+        if (!strcmp(a, "-T") || !strcmp(a, "-I")) {
+            if (i + 1 >= argc) { fprintf(stderr, "stc: %s needs a folder\n", a); return 1; }
+            if (a[1] == 'T') outdir = argv[i + 1];
+            i++;
+            continue;
+        }
+        if (!strncmp(a, "-T", 2)) { outdir = a + 2; continue; }
+        if (!strncmp(a, "-I", 2)) continue;
+        if (a[0] == '-' && a[1]) { fprintf(stderr, "stc: unknown option '%s'\n", a); usage(stderr); return 1; }
+        if (input) { fprintf(stderr, "stc: only one input file, got '%s' and '%s'\n", input, a); return 1; }
+        input = a;
+    }
+    if (!input) { usage(stderr); return 1; }
+
+    Source lib = {"<standard library>", stdlib_st, strlen(stdlib_st)};
+    Source src = {input, NULL, 0};
+    src.text = read_file(input, &src.len);
+    Unit u = {0};
+    parse_unit(&u, &lib, true);
+    int nlib = u.pous.n;
+    parse_unit(&u, &src, false);
+    if (u.pous.n == nlib && !u.types.n && !u.configs.n) {
+        Loc at = {&src, 1, 1};
+        fatal_at(at, "nothing to compile: no FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
+    }
+    sema(&u);
+    if (error_count) return 1;
+    struct stat st;
+    if (stat(outdir, &st) != 0 && mkdir(outdir, 0777) != 0) {
+        fprintf(stderr, "stc: cannot create '%s': %s\n", outdir, strerror(errno));
+        return 1;
+    }
+    return codegen(&u, outdir) ? 1 : 0;
+}
