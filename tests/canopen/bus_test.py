@@ -80,7 +80,8 @@ m = Master(["-i", "vcan0", "-n", "2,3,9", "-c", "5000", "-H", "100:250"])
 
 # 2. start-up: nodes 2 and 3 configured and started, node 9 reported
 ok = m.wait("start-up done", 8) is not None
-report("startup", ok and s2.state == 5 and s3.state == 5,
+ok = ok and wait_for(lambda: s2.state == 5 and s3.state == 5, 1)
+report("startup", ok,
        f"states {s2.state} {s3.state}")
 report("silent_node_reported",
        m.seen("node 9 does not answer: SDO upload of object 0x1000:00 timed out") is not None)
