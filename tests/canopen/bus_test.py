@@ -76,7 +76,7 @@ net = connect("vcan0")
 s2 = Slave401(net, 2)
 s3 = Slave401(net, 3)
 HB_CONS = 0.250
-m = Master(["-i", "vcan0", "-n", "2,3,9", "-c", "5000", "-H", "100:250"])
+m = Master(["-i", "vcan0", "-n", "2,3,9", "-c", "10000", "-H", "100:250"])
 
 # 2. start-up: nodes 2 and 3 configured and started, node 9 reported
 ok = m.wait("start-up done", 8) is not None
