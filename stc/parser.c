@@ -270,8 +270,11 @@ static Node *unary(P *p) {
 }
 
 static Node *binary(P *p, Token *op, Node *l, Node *r) {
-    (void)p;
     Node *n = new_node(N_BINARY, op);
+    /* a long chain a+b+c+... nests as deeply as parentheses would */
+    n->depth = (l->depth > r->depth ? l->depth : r->depth) + 1;
+    if (n->depth + p->depth > MAX_DEPTH * 4)
+        fatal_at(op->loc, "expression too long (more than %d operators deep)", MAX_DEPTH * 4);
     n->op = op->up;
     if (!strcmp(n->op, "&")) n->op = "AND";
     n->lhs = l;

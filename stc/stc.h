@@ -114,6 +114,7 @@ struct Node {
     int64_t tval; TimeKind tkind;
     char *sval; int slen;
     bool is_out, negated;
+    int depth;        /* operator nesting below this node */
     /* filled by sema */
     Type *ty;
     Sym *sym;         /* resolved identifier / member */
