@@ -11,9 +11,6 @@ TESTS += canopen_plcrt
 # the CAN-driven axis, once the positioner library is there
 ifneq ($(ST_LIB),)
 $(eval $(call plcrt_program,canopen_axis,$(ST_LIB) tests/canopen/st/canopen_axis.st))
-# stc names a loop variable __k8, which gcc predefines on x86-64 (-march
-# x86-64 implies __k8 = 1); until the compiler avoids that name:
-$(BUILD)/plc/canopen_axis/program.o: PLC_GEN_CFLAGS += -U__k8
 .PHONY: canopen_axis
 canopen_axis: $(BUILD)/plc/canopen_axis/plcrt
 	@mk/suite.sh $(RESULTS) canopen_axis tests/canopen/uml_run.sh $(CO_BUILD)/uml_axis \
