@@ -47,7 +47,7 @@ for f in "$@"; do
     src=$(sed -n "${L}p" "$f" | tr -d '\r')
     caret=$(printf '%s\n' "$log" | awk -v n="$n" -v src="$src" -v col="$C" '
         NR <= n { next }
-        found { c = substr($0, p + col, 1); print (c == "^" ? "ok" : "caret"); exit }
+        found { c = substr($0, p + col - 1, 1); print (c == "^" ? "ok" : "caret"); exit }
         src != "" && (p = index($0, src)) > 0 { found = 1; next }
         src == "" && NR == n + 1 { p = 1; found = 1; next }
         END { if (!found) print "source" }')
