@@ -14,5 +14,10 @@ test-stc-errors: $(STC)
 	@mk/suite.sh $(RESULTS) stc-errors env STC="$(STC)" \
 	    tests/stc/errors.sh $(STC_TESTS)/errors $(sort $(wildcard tests/stc/errors/*.st))
 
-TESTS += test-stc-run test-stc-errors
-.PHONY: test-stc-run test-stc-errors
+test-stc-contract: $(STC)
+	@mkdir -p $(STC_TESTS)
+	@mk/suite.sh $(RESULTS) stc-contract env STC="$(STC)" STC_INC="$(STC_INC)" \
+	    CC="$(CC)" CFLAGS="$(CFLAGS)" tests/stc/contract.sh $(STC_TESTS)/contract
+
+TESTS += test-stc-run test-stc-errors test-stc-contract
+.PHONY: test-stc-run test-stc-errors test-stc-contract
