@@ -12,7 +12,8 @@ test-stc-run: $(STC)
 test-stc-errors: $(STC)
 	@mkdir -p $(STC_TESTS)
 	@mk/suite.sh $(RESULTS) stc-errors env STC="$(STC)" \
-	    tests/stc/errors.sh $(STC_TESTS)/errors $(sort $(wildcard tests/stc/errors/*.st))
+	    tests/stc/errors.sh $(STC_TESTS)/errors \
+	    $(sort $(wildcard tests/stc/errors/*.st)) $(sort $(wildcard tests/stc/robust/*.st))
 
 test-stc-contract: $(STC)
 	@mkdir -p $(STC_TESTS)
