@@ -270,8 +270,11 @@ static Node *unary(P *p) {
 }
 
 static Node *binary(P *p, Token *op, Node *l, Node *r) {
-    (void)p;
     Node *n = new_node(N_BINARY, op);
+    /* a long chain a+b+c+... nests as deeply as parentheses would */
+    n->depth = (l->depth > r->depth ? l->depth : r->depth) + 1;
+    if (n->depth + p->depth > MAX_DEPTH * 4)
+        fatal_at(op->loc, "expression too long (more than %d operators deep)", MAX_DEPTH * 4);
     n->op = op->up;
     if (!strcmp(n->op, "&")) n->op = "AND";
     n->lhs = l;
@@ -690,6 +693,18 @@ static Node *statement(P *p) {
             n->rhs = expr(p);
             expect_p(p, ";");
             return n;
+        }
+        if ((target->kind == N_INDEX || target->kind == N_MEMBER) && is_p(cur(p), "(")) {
+            /* an instance reached through an array or a member: a[i](...) */
+            Token *open = next(p);
+            Node *call = new_node(N_CALL, open);
+            call->start = target->start;
+            call->loc = target->start;
+            call->lhs = target;
+            call->name = "instance";
+            call->uname = "";
+            call_args(p, call);
+            target = call;
         }
         if (target->kind == N_CALL) {
             n = new_node(S_CALL, t);

@@ -103,8 +103,7 @@ const char stdlib_st[] =
 "  IF Q THEN\n"
 "    ET := NOW - START;\n"
 "    IF ET >= PT THEN ET := PT; Q := FALSE; END_IF;\n"
-"  ELSIF NOT IN THEN\n"
-"    ET := T#0s;\n"
 "  END_IF;\n"
+"  IF NOT Q AND NOT IN THEN ET := T#0s; END_IF;\n"
 "  PREV := IN;\n"
 "END_FUNCTION_BLOCK\n";

@@ -55,6 +55,17 @@ static inline IEC_TIME __real_to_time(LREAL s) {
     return __time_from_ns((LINT)llround(s * 1e9));
 }
 
+static inline IEC_TIME __dt_to_tod(IEC_TIME t) {
+    long d = t.tv_sec % 86400;
+    if (d < 0) d += 86400;
+    IEC_TIME r = {d, t.tv_nsec};
+    return r;
+}
+static inline IEC_TIME __dt_to_date(IEC_TIME t) {
+    IEC_TIME r = {t.tv_sec - __dt_to_tod(t).tv_sec, 0};
+    return r;
+}
+
 /* ---- strings ---- */
 static inline int __str_cmp(STRING a, STRING b) {
     int n = a.len < b.len ? a.len : b.len;

@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""plcrt benchmarks: wake latency beside cyclictest, Modbus throughput under
+libmodbus's bandwidth-client, and the runtime's own cost per cycle.
+
+usage: bench.py PLCRT_1MS PLCRT_250US BANDWIDTH_CLIENT PORT WORKDIR"""
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+P1, P250, BW, PORT, WORK = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5]
+SECONDS = int(os.environ.get("BENCH_SECONDS", "10"))
+os.makedirs(WORK, exist_ok=True)
+
+
+def ini(modbus=True, prio=80, clients=32):
+    path = os.path.join(WORK, f"bench-{int(modbus)}-{prio}.ini")
+    with open(path, "w") as f:
+        f.write(f"[scan]\npriority = {prio}\nlock_memory = {'yes' if prio else 'no'}\n"
+                f"[io]\nbackend = none\n[modbus]\nenabled = {'yes' if modbus else 'no'}\n"
+                f"port = {PORT}\nmax_clients = {clients}\n[retain]\nfile =\n")
+    return path
+
+
+def start(binary, cfg, prefix=()):
+    log = open(os.path.join(WORK, "plcrt.log"), "w+")
+    p = subprocess.Popen([*prefix, binary, "-c", cfg], stdout=log, stderr=log)
+    p.logf = log
+    return p
+
+
+def wait_port():
+    for _ in range(400):
+        try:
+            socket.create_connection(("127.0.0.1", PORT), timeout=0.2).close()
+            return
+        except OSError:
+            time.sleep(0.05)
+    raise RuntimeError("plcrt does not listen")
+
+
+def stop(p):
+    p.send_signal(signal.SIGTERM)
+    p.wait(timeout=120)
+    p.logf.seek(0)
+    return p.logf.read()
+
+
+def plcrt_stats(text):
+    """{'lat': {...}, 'exec': {...}, 'cycles': n, 'overruns': n} from the exit statistics."""
+    out = {}
+    m = re.search(r"statistics: (\d+) cycles of [\d.]+ us, (\d+) overruns", text)
+    out["cycles"], out["overruns"] = int(m.group(1)), int(m.group(2))
+    for key, name in (("lat", "wake latency"), ("exec", "execution")):
+        m = re.search(name + r"\s+min\s+([\d.]+)\s+mean\s+([\d.]+)\s+p99\s+([\d.]+)\s+p99.9\s+([\d.]+)\s+max\s+([\d.]+)", text)
+        out[key] = dict(zip(("min", "mean", "p99", "p999", "max"), map(float, m.groups())))
+    return out
+
+
+def cyclictest_stats(text):
+    hist, over = {}, 0
+    for line in text.splitlines():
+        m = re.match(r"^(\d+)\s+(\d+)\s*$", line)
+        if m:
+            hist[int(m.group(1))] = int(m.group(2))
+    n = sum(hist.values())
+    mx = int(re.search(r"# Max Latencies:\s+(\d+)", text).group(1))
+    mn = int(re.search(r"# Min Latencies:\s+(\d+)", text).group(1))
+    avg = float(re.search(r"# Avg Latencies:\s+(\d+)", text).group(1))
+
+    def q(frac):
+        want, seen = frac * n, 0
+        for us in sorted(hist):
+            seen += hist[us]
+            if seen > want:
+                return min(us + 1, mx)        # upper edge of the 1 us bin, as plcrt reports
+        return mx
+    return {"min": mn, "mean": avg, "p99": q(0.99), "p999": q(0.999), "max": mx, "n": n}
+
+
+def row(name, d):
+    return f"  {name:<22} min {d['min']:8.1f}  mean {d['mean']:8.1f}  p99 {d['p99']:8.1f}  p99.9 {d['p999']:8.1f}  max {d['max']:8.1f} us"
+
+
+def latency(binary, period_us):
+    p = start(binary, ini(modbus=True))
+    wait_port()
+    loops = SECONDS * 1000000 // period_us
+    ct = subprocess.run(["cyclictest", "-m", "-q", "-t", "1", "-p", "80", "-i", str(period_us),
+                         "-l", str(loops), "-h", "10000"], capture_output=True, text=True)
+    st = plcrt_stats(stop(p))
+    c = cyclictest_stats(ct.stdout)
+    print(f"\nwake latency at {period_us} us, {SECONDS} s, SCHED_FIFO 80, plcrt and cyclictest in the same run:")
+    print(row("plcrt", st["lat"]))
+    print(row("cyclictest", c))
+    r99 = st["lat"]["p99"] / max(c["p99"], 1)
+    rmax = st["lat"]["max"] / max(c["max"], 1)
+    print(f"  ratio plcrt/cyclictest: p99 {r99:.2f}x, max {rmax:.2f}x (aim: <= 1.1x); "
+          f"{st['overruns']} overruns in {st['cycles']} cycles")
+    return st
+
+
+def modbus():
+    print(f"\nModbus TCP, FC 3 of 125 registers (libmodbus bandwidth-client), scanning every 1 ms:")
+    for n in (1, 4, 16):
+        p = start(P1, ini(modbus=True))
+        wait_port()
+        t0 = time.time()
+        clients = [subprocess.Popen([BW], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True) for _ in range(n)]
+        outs = [c.communicate()[0] for c in clients]
+        wall = time.time() - t0
+        st = plcrt_stats(stop(p))
+        rates = []
+        for o in outs:
+            m = re.search(r"READ REGISTERS\s+Transfert rate in points/seconds:\s+\* (\d+) registers/s", o)
+            rates.append(int(m.group(1)) / 125 if m else 0)
+        print(f"  {n:2d} client(s): {sum(rates):9.0f} requests/s in total ({min(rates):7.0f}..{max(rates):7.0f} per client), "
+              f"{st['overruns']} overruns in {st['cycles']} cycles, worst execution {st['exec']['max']:.1f} us, "
+              f"worst wake latency {st['lat']['max']:.1f} us ({wall:.1f} s)")
+
+
+def cost(st_mb):
+    print("\nthe runtime's own cost per cycle, empty program at 1 ms:")
+    print(f"  wall clock (from the 1 ms latency run, Modbus on, no client): mean {st_mb['exec']['mean']:.1f} us, "
+          f"p99 {st_mb['exec']['p99']:.1f} us, max {st_mb['exec']['max']:.1f} us")
+    for mb in (False, True):
+        out = os.path.join(WORK, f"callgrind.{int(mb)}")
+        p = start(P1, ini(modbus=mb, prio=0),
+                  prefix=("valgrind", "--tool=callgrind", "--toggle-collect=scan_cycle", f"--callgrind-out-file={out}"))
+        if mb:
+            wait_port()
+        time.sleep(4)
+        text = stop(p)
+        st = plcrt_stats(text)
+        ann = subprocess.run(["callgrind_annotate", out], capture_output=True, text=True).stdout
+        m = re.search(r"^\s*([\d,]+)\s+\(100.0%\)\s+PROGRAM TOTALS", ann, re.M) or re.search(r"^\s*([\d,]+)\s+PROGRAM TOTALS", ann, re.M)
+        ir = int(m.group(1).replace(",", "")) if m else 0
+        print(f"  instructions per cycle (valgrind, inside scan_cycle), Modbus {'on ' if mb else 'off'}: "
+              f"{ir / max(st['cycles'], 1):8.0f}  ({st['cycles']} cycles)")
+
+
+def main():
+    st1 = latency(P1, 1000)
+    latency(P250, 250)
+    modbus()
+    cost(st1)
+
+
+main()

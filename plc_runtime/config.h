@@ -1,0 +1,66 @@
+/*
+** config.h: the INI configuration (libinih). Every key, its default and
+** meaning are documented in docs/config.md. Sections that belong to an I/O
+** backend ([sim], [sim.axis0], [canopen...]) are handed to the selected
+** backend; sections of other known backends are ignored, so switching
+** backend is one key; anything else is an error.
+*/
+#ifndef PLC_CONFIG_H
+#define PLC_CONFIG_H
+
+#include <stddef.h>
+#include "io_backend.h"
+
+#define CFG_MAX_SYMBOLS 256
+#define CFG_MAX_STATUS 8
+
+enum { MB_COILS, MB_DISCRETE, MB_INPUT, MB_HOLDING };
+
+typedef struct cfg_symbol {
+    char path[160];
+    int table;          /* MB_COILS .. MB_HOLDING */
+    unsigned addr;
+    int writable;
+    int line;           /* where it was declared, for later messages */
+} cfg_symbol;
+
+typedef struct plc_config {
+    char file[256];
+    /* [plc] */
+    int log_level;
+    int status_interval;                /* s, 0 = no status line */
+    char status_vars[CFG_MAX_STATUS][160];
+    int nstatus;
+    /* [scan] */
+    int priority;                       /* SCHED_FIFO priority, 0 = normal */
+    int cpu;                            /* -1 = any */
+    int lock_memory;
+    int overrun_log_interval;           /* s */
+    /* [io] */
+    char backend[32];
+    const io_backend_ops *io;
+    void *io_state;                     /* created during parsing */
+    /* [modbus] */
+    int mb_enabled;
+    char mb_bind[64];
+    int mb_port;
+    int mb_max_clients;
+    int mb_idle_timeout;                /* s, 0 = never */
+    cfg_symbol symbols[CFG_MAX_SYMBOLS];
+    int nsymbols;
+    /* [retain] */
+    char retain_file[256];              /* "" = no retain */
+    int retain_period;                  /* s, 0 = only at shutdown */
+} plc_config;
+
+/* Defaults, with backend `sim` created. */
+int config_defaults(plc_config *c, char *err, size_t errlen);
+/* Read path over the defaults. 0, or -1 with "FILE:LINE: ..." in err. */
+int config_load(plc_config *c, const char *path, char *err, size_t errlen);
+/* Read INI text (for tests); name is used in messages. */
+int config_load_string(plc_config *c, const char *name, const char *text,
+                       char *err, size_t errlen);
+/* Free the backend state if the backend was never opened. */
+void config_free(plc_config *c);
+
+#endif

@@ -1,0 +1,70 @@
+/*
+** io_backend.h: the interface between the scan and an I/O backend.
+**
+** A backend moves data between the process image and the outside world
+** (a simulated plant, CANopen nodes, ...). The configuration file selects
+** one with `[io] backend = NAME`. Life of a backend, all calls from the
+** runtime's threads as noted:
+**
+**   create()            main thread, before the config file is read
+**   config() per key    main thread, for every key of a section named
+**                       NAME or NAME.anything (e.g. [canopen.node3])
+**   open()              main thread, after the whole file was read and
+**                       before the first cycle: validate, open devices
+**   read_inputs()       scan thread, at the start of each cycle
+**   write_outputs()     scan thread, at the end of each cycle
+**   safe_state()        main thread, once, after the scan has stopped, with
+**                       the image's %Q areas already zeroed: bring every
+**                       physical output to its safe state (0 V, off)
+**   close()             main thread, last; frees the state
+**
+** Rules: read_inputs/write_outputs run in the real-time scan, so they never
+** block, allocate or log at length (use the rate-limited plc_log). They
+** only touch the image passed in. Errors found while running are reported
+** through diag() (and may make read_inputs return -1 once per occurrence,
+** which the runtime counts and logs); they never stop the scan.
+**
+** To add a backend: implement an io_backend_ops, and list it in
+** io_backends.c.
+*/
+#ifndef IO_BACKEND_H
+#define IO_BACKEND_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "plc_image.h"
+
+#define IO_DIAG_MAX 64     /* registers a backend may publish over Modbus */
+
+typedef struct io_backend_ops {
+    const char *name;
+    /* Allocate and default the backend's state; NULL on out of memory. */
+    void *(*create)(void);
+    /* One key of one of the backend's sections. Return 0 if accepted;
+    ** otherwise -1 with a message in err (the runtime adds file, line,
+    ** section and key). */
+    int (*config)(void *st, const char *section, const char *key,
+                  const char *value, char *err, size_t errlen);
+    /* Check the configuration as a whole and acquire the devices.
+    ** ticktime_ns is the scan period. 0, or -1 with a message in err. */
+    int (*open)(void *st, plc_image *img, uint64_t ticktime_ns,
+                char *err, size_t errlen);
+    /* Fill the %I areas. now_ns: PLC time of this cycle (monotonic, starts
+    ** at 0, advances by whole periods). 0, or -1 on an I/O error. */
+    int (*read_inputs)(void *st, plc_image *img, uint64_t now_ns);
+    /* Send the %Q areas out. 0, or -1 on an I/O error. */
+    int (*write_outputs)(void *st, const plc_image *img);
+    /* Outputs to their safe state (see above). */
+    void (*safe_state)(void *st, plc_image *img);
+    void (*close)(void *st);
+    /* Copy up to max diagnostic registers (16-bit) into regs; return how
+    ** many. Called from the scan thread once per cycle. May be NULL. */
+    size_t (*diag)(void *st, uint16_t *regs, size_t max);
+} io_backend_ops;
+
+/* The backend named name, or NULL. */
+const io_backend_ops *io_backend_find(const char *name);
+/* NULL-terminated list of all backends (for section ownership and help). */
+extern const io_backend_ops *const io_backends[];
+
+#endif

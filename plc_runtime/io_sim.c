@@ -1,0 +1,184 @@
+/*
+** io_sim.c: the `sim` backend: up to SIM_AXES simulated axes (plant.h),
+** each bound to located variables by [sim.axisN] sections. Without any
+** such section one axis runs with the default bindings (docs/config.md).
+*/
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "io_backend.h"
+#include "../c_blocks/plant.h"
+
+#define SIM_AXES 8
+
+enum { B_DAC, B_COUNTER, B_LATCH, B_ZERO, B_CAM, B_ZCOUNT, NBIND };
+static const char *bind_keys[NBIND] = { "dac", "counter", "latch", "zero", "cam", "zero_count" };
+static const char bind_size[NBIND] = { 'W', 'D', 'D', 'X', 'X', 'W' };
+static const char *bind_default[NBIND] = { "%QW0", "%ID0", "%ID1", "%IX0.0", "%IX0.1", "" };
+
+typedef struct sim_axis {
+    int used;
+    plant_params p;
+    plant s;
+    plc_loc loc[NBIND];
+    int bound[NBIND];
+    int16_t dac;
+} sim_axis;
+
+typedef struct sim {
+    sim_axis ax[SIM_AXES];
+    int configured;       /* any [sim.axisN] seen */
+    uint64_t last_ns;
+    int started;
+} sim;
+
+static void axis_defaults(sim_axis *a)
+{
+    memset(a, 0, sizeof *a);
+    plant_defaults(&a->p);
+    for (int i = 0; i < NBIND; i++)
+        if (bind_default[i][0]) a->bound[i] = !plc_loc_parse(bind_default[i], &a->loc[i]);
+}
+
+static void *create(void)
+{
+    sim *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    axis_defaults(&s->ax[0]);
+    s->ax[0].used = 1;
+    return s;
+}
+
+static int num(const char *v, double *out)
+{
+    char *end;
+    double x = strtod(v, &end);
+    if (end == v || *end) return -1;
+    *out = x;
+    return 0;
+}
+
+static int config(void *st, const char *sec, const char *key, const char *v, char *err, size_t n)
+{
+    sim *s = st;
+    unsigned idx;
+    char tail;
+    if (!strcmp(sec, "sim")) { snprintf(err, n, "unknown key (axes are [sim.axis0] .. [sim.axis7])"); return -1; }
+    if (sscanf(sec, "sim.axis%u%c", &idx, &tail) != 1 || idx >= SIM_AXES) {
+        snprintf(err, n, "unknown section (axes are [sim.axis0] .. [sim.axis7])");
+        return -1;
+    }
+    if (!s->configured) { s->configured = 1; s->ax[0].used = 0; }
+    sim_axis *a = &s->ax[idx];
+    if (!a->used) { axis_defaults(a); a->used = 1; for (int i = 0; i < NBIND; i++) a->bound[i] = 0; }
+    for (int i = 0; i < NBIND; i++) {
+        if (strcmp(key, bind_keys[i])) continue;
+        if (!*v) { a->bound[i] = 0; return 0; }
+        plc_loc l;
+        if (plc_loc_parse(v, &l)) { snprintf(err, n, "'%s' is not a located address inside the process image", v); return -1; }
+        if (l.size != bind_size[i]) { snprintf(err, n, "'%s' must be a %%..%c address", v, bind_size[i]); return -1; }
+        if (i == B_DAC ? l.area == 'I' : l.area == 'Q') {
+            snprintf(err, n, "'%s': %s must be %s", v, key, i == B_DAC ? "an output (%Q or %M)" : "an input (%I or %M)");
+            return -1;
+        }
+        a->loc[i] = l;
+        a->bound[i] = 1;
+        return 0;
+    }
+    static const struct { const char *k; size_t off; double lo, hi; } pk[] = {
+#define P(k, f, lo, hi) { k, offsetof(plant_params, f), lo, hi }
+        P("maxvel", maxvel, 0, 1e9), P("lag", lag, 0, 100), P("offset", offset, -10, 10),
+        P("drift", drift, -10, 10), P("deadband", deadband, 0, 10),
+        P("counts_per_rev", counts_per_rev, 0, 1e9), P("zero_offset", zero_offset, -1e9, 1e9),
+        P("resonance", resonance, 0, 10000), P("damping", damping, 0, 100),
+        P("cam_low", cam_low, -2147483648.0, 2147483647.0),
+        P("cam_high", cam_high, -2147483648.0, 2147483647.0),
+        P("start", start, -2147483648.0, 2147483647.0),
+#undef P
+    };
+    for (size_t i = 0; i < sizeof pk / sizeof pk[0]; i++) {
+        if (strcmp(key, pk[i].k)) continue;
+        double x;
+        if (num(v, &x) || x < pk[i].lo || x > pk[i].hi) {
+            snprintf(err, n, "'%s' is not a number in %g..%g", v, pk[i].lo, pk[i].hi);
+            return -1;
+        }
+        *(double *)((char *)&a->p + pk[i].off) = x;
+        return 0;
+    }
+    snprintf(err, n, "unknown key");
+    return -1;
+}
+
+static int open_(void *st, plc_image *img, uint64_t tick, char *err, size_t n)
+{
+    sim *s = st;
+    (void)img; (void)tick;
+    for (int i = 0; i < SIM_AXES; i++) {
+        sim_axis *a = &s->ax[i];
+        if (!a->used) continue;
+        if (!a->bound[B_DAC] || !a->bound[B_COUNTER]) {
+            snprintf(err, n, "[sim.axis%d]: dac and counter must be set", i);
+            return -1;
+        }
+        plant_init(&a->s, &a->p);
+    }
+    s->started = 0;
+    return 0;
+}
+
+static int rd(void *st, plc_image *img, uint64_t now)
+{
+    sim *s = st;
+    double dt = s->started ? (now - s->last_ns) * 1e-9 : 0;
+    s->started = 1;
+    s->last_ns = now;
+    for (int i = 0; i < SIM_AXES; i++) {
+        sim_axis *a = &s->ax[i];
+        if (!a->used) continue;
+        plant_step(&a->s, a->dac, dt);
+        img_set32(plc_loc_ptr(img, &a->loc[B_COUNTER]), 0, plant_counter(&a->s));
+        if (a->bound[B_LATCH]) img_set32(plc_loc_ptr(img, &a->loc[B_LATCH]), 0, a->s.latch);
+        if (a->bound[B_ZERO]) *plc_loc_ptr(img, &a->loc[B_ZERO]) = (uint8_t)a->s.zero;
+        if (a->bound[B_CAM]) *plc_loc_ptr(img, &a->loc[B_CAM]) = (uint8_t)plant_cam(&a->s);
+        if (a->bound[B_ZCOUNT]) img_set16(plc_loc_ptr(img, &a->loc[B_ZCOUNT]), 0, (int16_t)(uint16_t)a->s.zeros);
+    }
+    return 0;
+}
+
+static int wr(void *st, const plc_image *img)
+{
+    sim *s = st;
+    for (int i = 0; i < SIM_AXES; i++)
+        if (s->ax[i].used)
+            s->ax[i].dac = img_get16(plc_loc_ptr((plc_image *)img, &s->ax[i].loc[B_DAC]), 0);
+    return 0;
+}
+
+static void safe(void *st, plc_image *img)
+{
+    sim *s = st;
+    (void)img;
+    for (int i = 0; i < SIM_AXES; i++) s->ax[i].dac = 0;
+}
+
+static void close_(void *st) { free(st); }
+
+/* Per axis: position (counts) and speed (counts/s), 32-bit, high word first. */
+static size_t diag(void *st, uint16_t *r, size_t max)
+{
+    sim *s = st;
+    size_t n = 0;
+    for (int i = 0; i < SIM_AXES && n + 4 <= max; i++) {
+        int32_t pos = plant_counter(&s->ax[i].s), vel = (int32_t)s->ax[i].s.vl;
+        if (!s->ax[i].used) pos = vel = 0;
+        r[n++] = (uint16_t)((uint32_t)pos >> 16); r[n++] = (uint16_t)pos;
+        r[n++] = (uint16_t)((uint32_t)vel >> 16); r[n++] = (uint16_t)vel;
+    }
+    return n;
+}
+
+const io_backend_ops io_sim = {
+    "sim", create, config, open_, rd, wr, safe, close_, diag
+};

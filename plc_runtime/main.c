@@ -1,0 +1,307 @@
+/*
+** main.c: plcrt's entry point and housekeeping thread: configuration,
+** start-up, status line, periodic retain saves, signals, shutdown.
+*/
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <pthread.h>
+#include <sched.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/mman.h>
+#include <time.h>
+#include <unistd.h>
+#include "config.h"
+#include "log.h"
+#include "mbmap.h"
+#include "mbserver.h"
+#include "program.h"
+#include "retain.h"
+#include "scan.h"
+
+#define PLCRT_VERSION "0.1.0"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "usage: plcrt [-c FILE.ini] [--check-config] [--help] [--version]\n"
+        "Runs the linked PLC program (configuration %s) every %.3f ms.\n"
+        "  -c, --config FILE   configuration file (docs/config.md); defaults otherwise\n"
+        "      --check-config  read the configuration, check it against the program, exit\n"
+        "  -h, --help          this text\n"
+        "  -V, --version       version and linked program\n"
+        "Signals: SIGINT/SIGTERM stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",
+        plc_program_linked.name, *plc_program_linked.ticktime / 1e6);
+}
+
+typedef struct retained {
+    retain_var *rv;       /* the files' view: copies in buf */
+    scan_sample *smp;     /* variable -> copy */
+    scan_sample *back;    /* copy -> variable (after loading) */
+    size_t n;
+    uint64_t gen;
+} retained;
+
+static int retained_setup(retained *r, const plc_program *p)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < p->nvars; i++) n += p->vars[i].retain;
+    r->n = n;
+    r->rv = calloc(n + 1, sizeof *r->rv);
+    r->smp = calloc(n + 1, sizeof *r->smp);
+    r->back = calloc(n + 1, sizeof *r->back);
+    if (!r->rv || !r->smp || !r->back) return -1;
+    size_t k = 0;
+    for (size_t i = 0; i < p->nvars; i++) {
+        const plc_var *v = &p->vars[i];
+        if (!v->retain) continue;
+        void *copy = calloc(1, v->size ? v->size : 1);
+        if (!copy) return -1;
+        r->rv[k] = (retain_var){ v->path, v->type, copy, v->size };
+        r->smp[k] = (scan_sample){ plc_var_addr(v), copy, v->size };
+        r->back[k] = (scan_sample){ copy, plc_var_addr(v), v->size };
+        k++;
+    }
+    return 0;
+}
+
+static void retain_now(scan *s, retained *r, const plc_config *c, int running)
+{
+    char err[512];
+    if (!c->retain_file[0] || !r->n) return;
+    if (scan_sample_now(s, r->smp, r->n, running, 1000)) {
+        plc_log(LOG_ERROR, "retain: the scan did not hand over the variables in time; not saved");
+        atomic_fetch_add(&s->retain_errors, 1);
+        return;
+    }
+    if (retain_save(c->retain_file, r->rv, r->n, ++r->gen, err, sizeof err)) {
+        plc_log(LOG_ERROR, "retain: %s", err);
+        atomic_fetch_add(&s->retain_errors, 1);
+    } else {
+        atomic_fetch_add(&s->retain_saves, 1);
+    }
+}
+
+/* One value for the status line. */
+static void fmt_var(char *out, size_t n, const plc_var *v, const void *d)
+{
+    const char *t = v->type;
+    int8_t i8; uint8_t u8; int16_t i16; uint16_t u16; int32_t i32; uint32_t u32;
+    int64_t i64; uint64_t u64; float f; double g;
+    if (!strcasecmp(t, "BOOL") || !strcasecmp(t, "USINT") || !strcasecmp(t, "BYTE")) { memcpy(&u8, d, 1); snprintf(out, n, "%u", u8); }
+    else if (!strcasecmp(t, "SINT")) { memcpy(&i8, d, 1); snprintf(out, n, "%d", i8); }
+    else if (!strcasecmp(t, "INT")) { memcpy(&i16, d, 2); snprintf(out, n, "%d", i16); }
+    else if (!strcasecmp(t, "UINT") || !strcasecmp(t, "WORD")) { memcpy(&u16, d, 2); snprintf(out, n, "%u", u16); }
+    else if (!strcasecmp(t, "DINT")) { memcpy(&i32, d, 4); snprintf(out, n, "%" PRId32, i32); }
+    else if (!strcasecmp(t, "UDINT") || !strcasecmp(t, "DWORD")) { memcpy(&u32, d, 4); snprintf(out, n, "%" PRIu32, u32); }
+    else if (!strcasecmp(t, "LINT")) { memcpy(&i64, d, 8); snprintf(out, n, "%" PRId64, i64); }
+    else if (!strcasecmp(t, "ULINT") || !strcasecmp(t, "LWORD")) { memcpy(&u64, d, 8); snprintf(out, n, "%" PRIu64, u64); }
+    else if (!strcasecmp(t, "REAL")) { memcpy(&f, d, 4); snprintf(out, n, "%.3f", f); }
+    else if (!strcasecmp(t, "LREAL")) { memcpy(&g, d, 8); snprintf(out, n, "%.3f", g); }
+    else snprintf(out, n, "(%s)", t);
+}
+
+static const char *short_path(const char *p)
+{
+    const char *q = strchr(p, '.');           /* drop the configuration name */
+    return q ? q + 1 : p;
+}
+
+int main(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        { "config", required_argument, 0, 'c' }, { "check-config", no_argument, 0, 'k' },
+        { "help", no_argument, 0, 'h' }, { "version", no_argument, 0, 'V' }, { 0, 0, 0, 0 }
+    };
+    const char *file = NULL;
+    int check = 0, o;
+    char err[600];
+    while ((o = getopt_long(argc, argv, "c:hV", opts, NULL)) != -1) {
+        switch (o) {
+        case 'c': file = optarg; break;
+        case 'k': check = 1; break;
+        case 'h': usage(stdout); return 0;
+        case 'V': printf("plcrt %s (program %s, %.3f ms)\n", PLCRT_VERSION, plc_program_linked.name,
+                         *plc_program_linked.ticktime / 1e6); return 0;
+        default: usage(stderr); return 2;
+        }
+    }
+    if (optind < argc) { fprintf(stderr, "plcrt: unexpected argument '%s'\n", argv[optind]); usage(stderr); return 2; }
+
+    static plc_config cfg;
+    if (config_defaults(&cfg, err, sizeof err) || (file && config_load(&cfg, file, err, sizeof err))) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        return 2;
+    }
+    plc_log_level(cfg.log_level);
+    const plc_program *prog = &plc_program_linked;
+    uint64_t period = *prog->ticktime;
+    if (!period) { fprintf(stderr, "plcrt: the program has no task interval\n"); return 2; }
+
+    /* The program's own initialisation first: located and external
+    ** variables get their addresses there. */
+    prog->init();
+
+    const plc_var *status[CFG_MAX_STATUS];
+    for (int i = 0; i < cfg.nstatus; i++)
+        if (!(status[i] = plc_var_find(prog, cfg.status_vars[i]))) {
+            fprintf(stderr, "plcrt: %s: [plc] status_vars: no variable %s in the program\n", cfg.file, cfg.status_vars[i]);
+            return 2;
+        }
+    mb_shared *mb = NULL;
+    if (cfg.mb_enabled && !(mb = mb_new(&cfg, prog, err, sizeof err))) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        return 2;
+    }
+    if (check) {
+        printf("%s: configuration OK (backend %s, %d Modbus symbols)\n",
+               file ? file : "(defaults)", cfg.backend, cfg.nsymbols);
+        return 0;
+    }
+
+    /* retain */
+    retained ret = {0};
+    if (retained_setup(&ret, prog)) { fprintf(stderr, "plcrt: out of memory\n"); return 1; }
+    if (cfg.retain_file[0] && ret.n) {
+        scan_sample_now(NULL, ret.smp, ret.n, 0, 0);     /* initial values as default */
+        if (!retain_load(cfg.retain_file, ret.rv, ret.n, &ret.gen))
+            scan_sample_now(NULL, ret.back, ret.n, 0, 0);
+    }
+
+    /* I/O */
+    if (cfg.io->open(cfg.io_state, &plc_img, period, err, sizeof err)) {
+        fprintf(stderr, "plcrt: %s: backend %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", cfg.backend, err);
+        return 2;
+    }
+
+    /* signals: handled by this thread only */
+    sigset_t sigs;
+    sigemptyset(&sigs);
+    sigaddset(&sigs, SIGINT); sigaddset(&sigs, SIGTERM); sigaddset(&sigs, SIGUSR1);
+    sigaddset(&sigs, SIGPIPE);
+    pthread_sigmask(SIG_BLOCK, &sigs, NULL);
+
+    static scan sc;
+    sc.prog = prog; sc.io = cfg.io; sc.io_state = cfg.io_state; sc.mb = mb;
+    sc.period_ns = period;
+    sc.started_ns = scan_now_ns();
+    struct timespec rt;
+    clock_gettime(CLOCK_REALTIME, &rt);
+    sc.base_sec = rt.tv_sec; sc.base_nsec = rt.tv_nsec;
+    stats_reset(&sc.stats);
+    if (mb) {
+        uint16_t diag[MB_DIAG_N];
+        scan_diag(&sc, diag);
+        mb_publish(mb, &plc_img, diag);
+    }
+
+    mb_server *srv = NULL;
+    if (mb && !(srv = mb_server_start(&cfg, mb, err, sizeof err))) {
+        fprintf(stderr, "plcrt: modbus: %s\n", err);
+        cfg.io->close(cfg.io_state);
+        return 1;
+    }
+
+    if (cfg.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE))
+        plc_log(LOG_WARN, "mlockall: %s: memory may be paged out (raise RLIMIT_MEMLOCK or run with CAP_IPC_LOCK)", strerror(errno));
+
+    pthread_attr_t at;
+    pthread_attr_init(&at);
+    if (cfg.cpu >= 0) {
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        CPU_SET(cfg.cpu, &set);
+        pthread_attr_setaffinity_np(&at, sizeof set, &set);
+    }
+    pthread_t th;
+    int rt_ok = 0;
+    if (cfg.priority > 0) {
+        struct sched_param sp = { .sched_priority = cfg.priority };
+        pthread_attr_setinheritsched(&at, PTHREAD_EXPLICIT_SCHED);
+        pthread_attr_setschedpolicy(&at, SCHED_FIFO);
+        pthread_attr_setschedparam(&at, &sp);
+        rt_ok = !pthread_create(&th, &at, scan_thread, &sc);
+        if (!rt_ok) {
+            plc_log(LOG_WARN, "SCHED_FIFO priority %d refused (%s): the scan runs with normal priority and its timing is not guaranteed",
+                    cfg.priority, "run as root or grant CAP_SYS_NICE");
+            pthread_attr_setinheritsched(&at, PTHREAD_INHERIT_SCHED);
+        }
+    }
+    if (!rt_ok && pthread_create(&th, &at, scan_thread, &sc)) {
+        fprintf(stderr, "plcrt: cannot start the scan thread\n");
+        return 1;
+    }
+    pthread_attr_destroy(&at);
+    plc_log(LOG_INFO, "running %s every %.3f ms (%s), backend %s", prog->name, period / 1e6,
+            rt_ok ? "SCHED_FIFO" : "normal priority", cfg.backend);
+
+    /* housekeeping */
+    uint64_t t_status = scan_now_ns(), t_retain = t_status, t_over = t_status;
+    uint64_t last_over = 0;
+    uint8_t sbuf[CFG_MAX_STATUS][64];
+    scan_sample ss[CFG_MAX_STATUS];
+    for (int i = 0; i < cfg.nstatus; i++)
+        ss[i] = (scan_sample){ plc_var_addr(status[i]), sbuf[i], status[i]->size <= 64 ? status[i]->size : 64 };
+    for (;;) {
+        struct timespec to = { 0, 200000000 };
+        int sig = sigtimedwait(&sigs, NULL, &to);
+        if (sig == SIGINT || sig == SIGTERM) {
+            plc_log(LOG_INFO, "%s: stopping", sig == SIGINT ? "SIGINT" : "SIGTERM");
+            break;
+        }
+        if (sig == SIGUSR1) stats_print(stderr, &sc.stats, period);
+        uint64_t now = scan_now_ns();
+        stat_summary es, ls;
+        stat_summarize(&sc.stats.exec, &es);
+        stat_summarize(&sc.stats.lat, &ls);
+        atomic_store(&sc.exec_p99_ns, es.p99_ns);
+        atomic_store(&sc.lat_p99_ns, ls.p99_ns);
+        uint64_t ov = atomic_load(&sc.stats.overruns);
+        if (ov != last_over && now - t_over >= (uint64_t)cfg.overrun_log_interval * 1000000000u) {
+            plc_log(LOG_WARN, "%" PRIu64 " overrun(s) (total %" PRIu64 ", %" PRIu64 " periods skipped); worst execution %.1f us",
+                    ov - last_over, ov, (uint64_t)atomic_load(&sc.stats.missed), es.max_ns / 1e3);
+            last_over = ov;
+            t_over = now;
+        }
+        if (cfg.status_interval && now - t_status >= (uint64_t)cfg.status_interval * 1000000000u) {
+            t_status = now;
+            char line[1024];
+            int k = snprintf(line, sizeof line, "cycles %" PRIu64 "  overruns %" PRIu64 "  worst latency %.1f us",
+                             (uint64_t)atomic_load(&sc.stats.cycles), ov, ls.max_ns / 1e3);
+            if (cfg.nstatus && !scan_sample_now(&sc, ss, (size_t)cfg.nstatus, 1, 500)) {
+                for (int i = 0; i < cfg.nstatus && k < (int)sizeof line - 80; i++) {
+                    char val[64];
+                    fmt_var(val, sizeof val, status[i], sbuf[i]);
+                    k += snprintf(line + k, sizeof line - (size_t)k, "  %s %s", short_path(status[i]->path), val);
+                }
+            }
+            printf("%s\n", line);
+            fflush(stdout);
+        }
+        if (cfg.retain_period && now - t_retain >= (uint64_t)cfg.retain_period * 1000000000u) {
+            t_retain = now;
+            retain_now(&sc, &ret, &cfg, 1);
+        }
+    }
+
+    /* shutdown: outputs safe first, then land acknowledged writes, save */
+    atomic_store(&sc.stop, 1);
+    pthread_join(th, NULL);
+    memset(plc_img.qx, 0, sizeof plc_img.qx);
+    memset(plc_img.qb, 0, sizeof plc_img.qb);
+    memset(plc_img.qw, 0, sizeof plc_img.qw);
+    memset(plc_img.qd, 0, sizeof plc_img.qd);
+    memset(plc_img.ql, 0, sizeof plc_img.ql);
+    cfg.io->safe_state(cfg.io_state, &plc_img);
+    mb_server_stop(srv);
+    if (mb) mb_apply(mb, &plc_img);
+    retain_now(&sc, &ret, &cfg, 0);
+    stats_print(stderr, &sc.stats, period);
+    cfg.io->close(cfg.io_state);
+    mb_free(mb);
+    return 0;
+}

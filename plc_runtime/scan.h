@@ -1,0 +1,48 @@
+/*
+** scan.h: the real-time scan thread. Each period (absolute
+** clock_nanosleep on CLOCK_MONOTONIC): read inputs -> apply Modbus writes
+** -> run the program -> publish to Modbus -> write outputs. A cycle that
+** ends past the next period boundary is an overrun: counted, and the next
+** cycle starts on the first boundary still ahead (never a burst).
+*/
+#ifndef SCAN_H
+#define SCAN_H
+
+#include <stdatomic.h>
+#include <stddef.h>
+#include "io_backend.h"
+#include "mbmap.h"
+#include "program.h"
+#include "stats.h"
+
+typedef struct scan_sample { void *src, *dst; size_t n; } scan_sample;
+
+typedef struct scan {
+    const plc_program *prog;
+    const io_backend_ops *io;
+    void *io_state;
+    mb_shared *mb;                 /* NULL: no Modbus */
+    uint64_t period_ns;
+    long base_sec, base_nsec;      /* __CURRENT_TIME at PLC time 0 */
+    plc_stats stats;
+    _Atomic uint64_t exec_p99_ns, lat_p99_ns;   /* set by housekeeping */
+    _Atomic uint64_t retain_saves, retain_errors;
+    _Atomic int stop;
+    /* copies of variables taken by the scan between two cycles */
+    _Atomic int sample_req;        /* 0 idle, 1 asked, 2 done */
+    const scan_sample *samples;
+    size_t nsamples;
+    uint64_t started_ns;
+} scan;
+
+void *scan_thread(void *arg);
+/* One cycle: inputs, Modbus writes, program, publish, outputs. */
+void scan_cycle(scan *s, uint64_t plc_ns, unsigned long tick);
+uint64_t scan_now_ns(void);
+/* Copy samples[] atomically with respect to cycles: through the scan when it
+** runs (waiting up to timeout_ms), directly otherwise. 0, or -1 on timeout. */
+int scan_sample_now(scan *s, const scan_sample *v, size_t n, int running, int timeout_ms);
+/* Fill the diagnostic registers (mbmap.h MBD_*). */
+void scan_diag(scan *s, uint16_t *diag);
+
+#endif

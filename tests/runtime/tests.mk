@@ -1,0 +1,65 @@
+# plcrt's tests (included from plc_runtime/part.mk). Check units built twice,
+# plainly and with $(SAN); integration tests against a running plcrt.
+
+RT_T := $(BUILD)/tests/runtime
+RT_CHECK_LIBS := $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lm -lrt -lpthread)
+RT_SRC_MAP := $(addprefix plc_runtime/,mbmap.c config.c program.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c
+RT_SRC_CFG := $(addprefix plc_runtime/,config.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c
+RT_SRC_RET := plc_runtime/retain.c plc_runtime/log.c
+
+define rt_unit
+$(RT_T)/$(1): tests/runtime/$(1).c $(2) $$(PLCRT_HDRS)
+	@mkdir -p $$(@D)
+	$$(CC) $$(PLCRT_CFLAGS) -o $$@ tests/runtime/$(1).c $(2) $$(RT_CHECK_LIBS) $$(PLCRT_LIBS)
+$(RT_T)/$(1)-san: tests/runtime/$(1).c $(2) $$(PLCRT_HDRS)
+	@mkdir -p $$(@D)
+	$$(CC) $$(PLCRT_CFLAGS) $$(SAN) -o $$@ tests/runtime/$(1).c $(2) $$(RT_CHECK_LIBS) $$(PLCRT_LIBS)
+endef
+$(eval $(call rt_unit,check_mbmap,$(RT_SRC_MAP)))
+$(eval $(call rt_unit,check_config,$(RT_SRC_CFG)))
+$(eval $(call rt_unit,check_retain,$(RT_SRC_RET)))
+$(eval $(call rt_unit,check_plant,c_blocks/plant.c))
+RT_UNITS := check_mbmap check_config check_retain check_plant
+RT_UNIT_BINS := $(foreach u,$(RT_UNITS),$(RT_T)/$(u) $(RT_T)/$(u)-san)
+
+.PHONY: test-runtime-units
+test-runtime-units: $(RT_UNIT_BINS)
+	@rc=0; for u in $(RT_UNITS); do \
+	  TMPDIR=$(abspath $(RT_T)) mk/suite.sh $(RESULTS) runtime-$$u $(RT_T)/$$u || rc=1; \
+	  TMPDIR=$(abspath $(RT_T)) mk/suite.sh $(RESULTS) runtime-$$u-san $(RT_T)/$$u-san || rc=1; \
+	done; exit $$rc
+TESTS += test-runtime-units
+
+# image binding: the real compiler's output of st/iotest.st
+$(eval $(call plcrt_program,rt_iotest,tests/runtime/st/iotest.st))
+$(RT_T)/check_image: tests/runtime/check_image.c $(BUILD)/plc/rt_iotest/program.o $(PLCRT_B)/plc_image.o $(PLCRT_B)/program.o
+	@mkdir -p $(@D)
+	$(CC) $(PLCRT_CFLAGS) -o $@ $^ $(RT_CHECK_LIBS)
+
+# the plant as an ST block (c_blocks/sim_axis.st) beside the sim backend
+$(eval $(call plcrt_program,rt_simblock,$(C_BLOCKS_ST) tests/runtime/st/simblock.st))
+$(RT_T)/check_sim_block: tests/runtime/check_sim_block.c $(BUILD)/plc/rt_simblock/program.o $(PLCRT_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(PLCRT_CFLAGS) -o $@ $^ $(RT_CHECK_LIBS) $(PLCRT_LIBS)
+
+.PHONY: test-runtime-image
+test-runtime-image: $(RT_T)/check_image $(RT_T)/check_sim_block $(STC)
+	@rc=0; mk/suite.sh $(RESULTS) runtime-image $(RT_T)/check_image || rc=1; \
+	mk/suite.sh $(RESULTS) runtime-sim-block $(RT_T)/check_sim_block || rc=1; \
+	mk/suite.sh $(RESULTS) runtime-located-outside tests/runtime/located_outside.sh \
+	  $(STC) $(STC_INC) $(RT_T)/outside $(CC) $(PLC_GEN_CFLAGS) || rc=1; exit $$rc
+TESTS += test-runtime-image
+
+# integration: libmodbus's own random-test-client, pointed at our test port
+RT_PORT := 15020
+RT_MB_EXAMPLES := /usr/share/doc/libmodbus-dev/examples
+$(RT_T)/random-test-client: $(RT_MB_EXAMPLES)/random-test-client.c
+	@mkdir -p $(@D)
+	sed 's/1502)/$(RT_PORT))/' $< > $@.c
+	$(CC) -O2 -w -o $@ $@.c $(shell pkg-config --cflags --libs libmodbus)
+
+.PHONY: test-runtime-integration
+test-runtime-integration: $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client
+	@mk/suite.sh $(RESULTS) runtime-integration python3 tests/runtime/test_plcrt.py \
+	  $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client $(RT_PORT) $(abspath $(RT_T))/integration
+TESTS += test-runtime-integration
