@@ -913,7 +913,8 @@ static void csv_vars(Buf *b, int *num, Pou *p, const char *path, bool retain) {
         if (s->cls == V_TEMP) continue;
         char *vp = fmt("%s.%s", path, s->uname);
         Type *c = ct(s->type);
-        bool r = retain || s->retain;
+        /* NON_RETAIN members stay volatile inside a RETAIN instance */
+        bool r = (retain || s->retain) && !(s->decl && s->decl->non_retain);
         if (c->kind == T_FB && !s->pointer) {
             buf_printf(b, "%d;FB;%s;%s;%s;;%d;\n", (*num)++, vp, vp, c->cname, r);
             csv_vars(b, num, c->pou, vp, r);

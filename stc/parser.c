@@ -538,15 +538,16 @@ static bool var_block(P *p, Vec *out, bool global_ok) {
     else return false;
     if (cls == V_GLOBAL && !global_ok) fatal_at(t->loc, "VAR_GLOBAL is only allowed in a CONFIGURATION or RESOURCE");
     next(p);
-    bool constant = false, retain = false;
+    bool constant = false, retain = false, non_retain = false;
     for (;;) {
         if (accept_kw(p, "CONSTANT")) constant = true;
-        else if (accept_kw(p, "RETAIN")) retain = true;
-        else if (accept_kw(p, "NON_RETAIN")) retain = false;
+        else if (accept_kw(p, "RETAIN")) retain = true, non_retain = false;
+        else if (accept_kw(p, "NON_RETAIN")) retain = false, non_retain = true;
         else break;
     }
     int first = out->n;
     var_decls(p, out, cls, constant, retain, t, "END_VAR");
+    for (int i = first; i < out->n; i++) ((VarDecl *)out->v[i])->non_retain = non_retain;
     /* matiec wants located variables in VAR blocks of their own */
     for (int i = first + 1; i < out->n; i++) {
         VarDecl *a = out->v[first], *d = out->v[i];

@@ -147,7 +147,7 @@ typedef struct VarDecl {
     char *name, *uname;
     Loc loc;
     VarClass cls;
-    bool constant, retain;
+    bool constant, retain, non_retain;
     char *location;       /* "%QW3" or NULL */
     Loc locloc;
     TypeSpec *spec;
