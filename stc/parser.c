@@ -484,6 +484,9 @@ static void var_decls(P *p, Vec *out, VarClass cls, bool constant, bool retain, 
             expected(p, "variable name");
         }
         Vec names = {0};
+        Token *n1 = peek(p, 1);
+        if (is_p(n1, ":=") || is_p(n1, "(") || is_p(n1, "[") || is_p(n1, "."))   /* a statement: the block was never closed */
+            fatal_at(open->loc, "%s without %s", open->up, end);
         do vec_push(&names, ident(p, "variable name")); while (accept_p(p, ","));
         char *location = NULL;
         Loc locloc = {0};
@@ -518,7 +521,6 @@ static void var_decls(P *p, Vec *out, VarClass cls, bool constant, bool retain, 
             d->init = init;
             vec_push(out, d);
         }
-        (void)open;
     }
 }
 

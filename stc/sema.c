@@ -619,7 +619,12 @@ static Type *unify(Node *n, Type *lt, Type *rt) {
 static Type *check_binary(Ctx *c, Node *n, Type *want) {
     OpClass k = op_class(n->op);
     Type *wop = NULL;
-    if (want && (k == OP_ARITH || k == OP_MOD || k == OP_LOGIC || k == OP_POW) && !is_err(want)) wop = want;
+    if (want && !is_err(want)) {
+        Type *cw = canon(want);
+        if ((k == OP_ARITH || k == OP_POW) && (is_num(cw) || is_timeish(cw))) wop = want;
+        else if (k == OP_MOD && is_int(cw)) wop = want;
+        else if (k == OP_LOGIC && (cw->kind == T_BOOL || is_bit(cw))) wop = want;
+    }
     bool time_scale = (!strcmp(n->op, "*") || !strcmp(n->op, "/")) && wop && is_timeish(wop);
     Type *lt = check(c, n->lhs, wop);
     Type *rwant = k == OP_POW ? NULL : time_scale ? NULL : wop;
@@ -780,6 +785,7 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
         }
         p->pou->used = true;
         n->callee = p->pou;
+        if (c->pou) vec_push(&c->pou->calls, p->pou);
         check_call_args(c, n, p->pou, false);
         return p->pou->rettype;
     }
@@ -866,12 +872,17 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
         }
         check_transfer(s->type, a->lhs, "type mismatch: parameter '%s' of '%s' expects %4$s, got %3$s", a->name, p->name);
     }
+    int missing = 0;
     for (int i = 0; i < params.n; i++) {
         Sym *s = params.v[i];
-        if (s->cls == V_IN_OUT && !given[i])
+        bool needed = s->cls == V_IN_OUT || (!is_fb && s->cls == V_INPUT && !s->decl->init);
+        if (!needed || given[i]) continue;
+        if (formal == 0 && !missing++)
+            error_at(call->loc, "'%s' expects %d argument%s, got %d", p->name, ninputs, ninputs == 1 ? "" : "s",
+                     call->list.n);
+        else if (formal != 0)
             error_at(call->loc, "missing parameter '%s' for '%s'", s->name, p->name);
     }
-    (void)is_fb;
 }
 
 /* ---- builtin functions ---- */
@@ -1524,6 +1535,15 @@ static void check_config(Ctx *c, Config *cf) {
     c->scope = NULL;
 }
 
+static bool calls_reach(Pou *from, Pou *target, int depth) {
+    if (depth > 64) return false;
+    for (int i = 0; i < from->calls.n; i++) {
+        Pou *q = from->calls.v[i];
+        if (q == target || calls_reach(q, target, depth + 1)) return true;
+    }
+    return false;
+}
+
 /* Standard FBs are only compiled when used; mark what used ones use. */
 static void mark_used(Ctx *c, Pou *p) {
     for (int i = 0; i < p->syms.n; i++) {
@@ -1604,6 +1624,11 @@ void sema(Unit *u) {
         check_stmts(&c, &p->body);
         c.pou = NULL;
         c.scope = NULL;
+    }
+    for (int i = 0; i < c.pous.n; i++) {
+        Pou *p = ((Sym *)c.pous.v[i])->pou;
+        if (p->kind == POU_FUNCTION && calls_reach(p, p, 0))
+            error_at(p->loc, "function '%s' calls itself (directly or through others): IEC 61131-3 forbids recursion", p->name);
     }
     for (int i = 0; i < u->configs.n; i++) check_config(&c, u->configs.v[i]);
     for (int i = 0; i < c.pous.n; i++) {

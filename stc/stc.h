@@ -169,6 +169,7 @@ struct Pou {
     bool uses_return;
     Type *type;           /* FB / program: its instance type */
     Vec syms;             /* Sym of its variables, in declaration order */
+    Vec calls;            /* functions it calls (Pou*) */
 };
 
 typedef struct TypeDecl { char *name, *uname; Loc loc; TypeSpec *spec; Node *init; } TypeDecl;
