@@ -304,7 +304,7 @@ static void lex_string(Lexer *L) {
             }
         }
         char one[2] = {c, 0};
-        if (c == 0) { b.s[b.n++] = 0; continue; }  /* keep embedded NUL out of C string handling */
+        if (c == 0) { buf_put(&b, " "); b.s[b.n - 1] = 0; continue; }   /* $00: a NUL byte in the string */
         buf_put(&b, one);
     }
     Token *t = add(L, TK_STRING, s, p + 1);
