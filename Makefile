@@ -33,7 +33,7 @@ test:
 	@mk/deps.sh
 	@$(MAKE) --no-print-directory all
 	@rm -rf $(RESULTS) && mkdir -p $(RESULTS)
-	@$(MAKE) --no-print-directory -k $(TESTS) || true
+	@$(MAKE) --no-print-directory -k $(TESTS) || touch $(RESULTS)/.make-failed
 	@mk/summary.sh $(RESULTS)
 
 run:

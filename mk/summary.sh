@@ -13,6 +13,11 @@ for f in "$dir"/*.log; do
         echo "  $(basename "$f" .log): suite did not finish"; fail=$((fail + 1))
     fi
 done
+# make -k went on past a suite that failed to build: it wrote no log, so
+# count it here unless a suite already reported the failure
+if [ -e "$dir/.make-failed" ] && [ "$fail" -eq 0 ]; then
+    echo "  a test suite failed to build or run (see the make errors above)"; fail=$((fail + 1))
+fi
 echo
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ] && [ "$pass" -gt 0 ]

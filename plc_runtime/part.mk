@@ -8,6 +8,8 @@ PLCRT_LIBS := -linih -lmodbus -lpthread -lm
 PLCRT_CORE := plc_image log stats config program mbmap mbserver retain scan \
               io_none io_sim io_backends
 PLCRT_OBJ  := $(PLCRT_CORE:%=$(PLCRT_B)/%.o) $(C_BLOCKS_OBJ)
+include $(wildcard plc_runtime/canopen/part.mk)
+PLCRT_OBJ  += $(CO_BACKEND)
 PLCRT_MAIN := $(PLCRT_B)/main.o
 PLCRT_HDRS := $(wildcard plc_runtime/*.h) c_blocks/plant.h
 # Flags for the compiler's generated C (override to build another
@@ -34,3 +36,4 @@ $(BUILD)/plc/$(1)/plcrt: $(BUILD)/plc/$(1)/program.o $$(PLCRT_MAIN) $$(PLCRT_OBJ
 endef
 
 -include tests/runtime/tests.mk
+-include tests/canopen/tests.mk

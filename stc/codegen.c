@@ -517,9 +517,9 @@ static void init_elements(G *g, Buf *b, const char *lv, Type *at, Node *init, in
                 if (cnt <= 0) continue;
                 int id = ++g->tmp;
                 indent(b, ind);
-                buf_printf(b, "for (LINT __k%d = %lld; __k%d < %lld; __k%d++) {\n", id, (long long)k, id,
+                buf_printf(b, "for (LINT __stc_k%d = %lld; __stc_k%d < %lld; __stc_k%d++) {\n", id, (long long)k, id,
                            (long long)(k + cnt), id);
-                init_value(g, b, fmt("%s.table[__k%d]", lv, id), at->elem, it->lhs, ind + 1);
+                init_value(g, b, fmt("%s.table[__stc_k%d]", lv, id), at->elem, it->lhs, ind + 1);
                 indent(b, ind);
                 buf_put(b, "}\n");
                 k += cnt;
@@ -532,8 +532,8 @@ static void init_elements(G *g, Buf *b, const char *lv, Type *at, Node *init, in
     if (k < at->count) {
         int id = ++g->tmp;
         indent(b, ind);
-        buf_printf(b, "for (LINT __k%d = %lld; __k%d < %lld; __k%d++) {\n", id, (long long)k, id, (long long)at->count, id);
-        init_value(g, b, fmt("%s.table[__k%d]", lv, id), at->elem, NULL, ind + 1);
+        buf_printf(b, "for (LINT __stc_k%d = %lld; __stc_k%d < %lld; __stc_k%d++) {\n", id, (long long)k, id, (long long)at->count, id);
+        init_value(g, b, fmt("%s.table[__stc_k%d]", lv, id), at->elem, NULL, ind + 1);
         indent(b, ind);
         buf_put(b, "}\n");
     }
@@ -588,31 +588,32 @@ static void fb_call(G *g, Buf *b, Node *call, int ind) {
     Sym *inst = call->sym;
     int id = ++g->tmp;
     indent(b, ind);
-    buf_printf(b, "{ %s *__fb%d = &", p->type->cname, id);
-    var_ref(g, b, inst);
+    buf_printf(b, "{ %s *__stc_fb%d = &", p->type->cname, id);
+    if (call->lhs) { buf_put(b, "("); expr(g, b, call->lhs); buf_put(b, ")"); }
+    else var_ref(g, b, inst);
     buf_put(b, ";\n");
     for (int i = 0; i < call->list.n; i++) {
         Node *a = call->list.v[i];
         if (a->sym->cls == V_OUTPUT) continue;
         indent(b, ind + 1);
         if (a->sym->cls == V_IN_OUT) {
-            buf_printf(b, "__fb%d->%s = &(", id, a->sym->uname);
+            buf_printf(b, "__stc_fb%d->%s = &(", id, a->sym->uname);
             expr(g, b, a->lhs);
             buf_put(b, ");\n");
         } else {
-            buf_printf(b, "__fb%d->%s = ", id, a->sym->uname);
+            buf_printf(b, "__stc_fb%d->%s = ", id, a->sym->uname);
             expr(g, b, a->lhs);
             buf_put(b, ";\n");
         }
     }
     indent(b, ind + 1);
-    buf_printf(b, "%s_body__(__fb%d);\n", p->type->cname, id);
+    buf_printf(b, "%s_body__(__stc_fb%d);\n", p->type->cname, id);
     for (int i = 0; i < call->list.n; i++) {
         Node *a = call->list.v[i];
         if (a->sym->cls != V_OUTPUT || !a->lhs) continue;
         indent(b, ind + 1);
         expr(g, b, a->lhs);
-        buf_printf(b, " = __fb%d->%s;\n", id, a->sym->uname);
+        buf_printf(b, " = __stc_fb%d->%s;\n", id, a->sym->uname);
     }
     indent(b, ind);
     buf_put(b, "}\n");
@@ -630,7 +631,7 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         buf_put(b, ";\n");
         return;
     case S_CALL:
-        if (s->lhs->sym && !s->lhs->builtin && s->lhs->callee && s->lhs->callee->kind != POU_FUNCTION) {
+        if ((s->lhs->sym || s->lhs->lhs) && !s->lhs->builtin && s->lhs->callee && s->lhs->callee->kind != POU_FUNCTION) {
             fb_call(g, b, s->lhs, ind);
             return;
         }
@@ -659,7 +660,7 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         int id = ++g->tmp;
         Type *t = s->lhs->ty;
         indent(b, ind);
-        buf_printf(b, "{ %s __sel%d = ", cty(t), id);
+        buf_printf(b, "{ %s __stc_sel%d = ", cty(t), id);
         expr(g, b, s->lhs);
         buf_put(b, ";\n");
         for (int i = 0; i < s->list2.n; i++) {
@@ -670,13 +671,13 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
                 Node *l = item->list.v[k];
                 if (k) buf_put(b, " || ");
                 if (l->kind == N_RANGE) {
-                    buf_printf(b, "(__sel%d >= ", id);
+                    buf_printf(b, "(__stc_sel%d >= ", id);
                     expr(g, b, l->lhs);
-                    buf_printf(b, " && __sel%d <= ", id);
+                    buf_printf(b, " && __stc_sel%d <= ", id);
                     expr(g, b, l->rhs);
                     buf_put(b, ")");
                 } else {
-                    buf_printf(b, "__sel%d == ", id);
+                    buf_printf(b, "__stc_sel%d == ", id);
                     expr(g, b, l);
                 }
             }
@@ -689,7 +690,7 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
             stmts(g, b, &s->els->list, ind + 2);
         }
         if (s->list2.n || s->els) { indent(b, ind + 1); buf_put(b, "}\n"); }
-        if (!s->list2.n && !s->els) { indent(b, ind + 1); buf_printf(b, "(void)__sel%d;\n", id); }
+        if (!s->list2.n && !s->els) { indent(b, ind + 1); buf_printf(b, "(void)__stc_sel%d;\n", id); }
         indent(b, ind);
         buf_put(b, "}\n");
         return;
@@ -703,27 +704,27 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         bool const_step = !s->fourth || (s->fourth->kind == N_INT);
         if (s->fourth && s->fourth->kind == N_INT) step = s->fourth->neg ? -(int64_t)s->fourth->ival : (int64_t)s->fourth->ival;
         indent(b, ind);
-        buf_printf(b, "{ %s __to%d = (%s)(", ctr, id, ctr);
+        buf_printf(b, "{ %s __stc_to%d = (%s)(", ctr, id, ctr);
         expr(g, b, s->third);
-        buf_printf(b, "); %s __by%d = (%s)(", ctr, id, ctr);
+        buf_printf(b, "); %s __stc_by%d = (%s)(", ctr, id, ctr);
         if (s->fourth) expr(g, b, s->fourth);
         else buf_put(b, "1");
         buf_put(b, ");\n");
         indent(b, ind + 1);
-        buf_printf(b, "for (%s __i%d = (%s)(", ctr, id, ctr);
+        buf_printf(b, "for (%s __stc_i%d = (%s)(", ctr, id, ctr);
         expr(g, b, s->rhs);
         if (const_step)
-            buf_printf(b, "); __i%d %s __to%d; __i%d += __by%d) {\n", id, step > 0 ? "<=" : ">=", id, id, id);
+            buf_printf(b, "); __stc_i%d %s __stc_to%d; __stc_i%d += __stc_by%d) {\n", id, step > 0 ? "<=" : ">=", id, id, id);
         else
-            buf_printf(b, "); __by%d > 0 ? __i%d <= __to%d : (__by%d < 0 && __i%d >= __to%d); __i%d += __by%d) {\n",
+            buf_printf(b, "); __stc_by%d > 0 ? __stc_i%d <= __stc_to%d : (__stc_by%d < 0 && __stc_i%d >= __stc_to%d); __stc_i%d += __stc_by%d) {\n",
                        id, id, id, id, id, id, id, id);
         indent(b, ind + 2);
         expr(g, b, s->lhs);
-        buf_printf(b, " = (%s)__i%d;\n", cty(t), id);
+        buf_printf(b, " = (%s)__stc_i%d;\n", cty(t), id);
         if (wide) {   /* stop before the counter wraps */
             stmts(g, b, &s->list, ind + 2);
             indent(b, ind + 2);
-            buf_printf(b, "if (__by%d > 0 ? __i%d > __to%d - __by%d : __i%d < __to%d - __by%d) break;\n", id, id, id,
+            buf_printf(b, "if (__stc_by%d > 0 ? __stc_i%d > __stc_to%d - __stc_by%d : __stc_i%d < __stc_to%d - __stc_by%d) break;\n", id, id, id,
                        id, id, id, id);
         } else {
             stmts(g, b, &s->list, ind + 2);
@@ -912,7 +913,8 @@ static void csv_vars(Buf *b, int *num, Pou *p, const char *path, bool retain) {
         if (s->cls == V_TEMP) continue;
         char *vp = fmt("%s.%s", path, s->uname);
         Type *c = ct(s->type);
-        bool r = retain || s->retain;
+        /* NON_RETAIN members stay volatile inside a RETAIN instance */
+        bool r = (retain || s->retain) && !(s->decl && s->decl->non_retain);
         if (c->kind == T_FB && !s->pointer) {
             buf_printf(b, "%d;FB;%s;%s;%s;;%d;\n", (*num)++, vp, vp, c->cname, r);
             csv_vars(b, num, c->pou, vp, r);
@@ -958,8 +960,10 @@ int codegen(Unit *u, const char *outdir) {
     buf_put(&g.h, "#ifndef __POUS_H\n#define __POUS_H\n\n#include \"iec_std_lib.h\"\n\n");
     buf_put(&g.c, banner);
     buf_put(&g.c, "#include \"POUS.h\"\n\n");
-    /* ST may compare a variable with itself (x = x is FALSE for a NaN) */
-    buf_put(&g.c, "#pragma GCC diagnostic ignored \"-Wtautological-compare\"\n\n");
+    /* ST may compare a variable with itself (x = x is FALSE for a NaN) or an
+       unsigned one with 0: legal, and not worth a warning in generated code */
+    buf_put(&g.c, "#pragma GCC diagnostic ignored \"-Wtautological-compare\"\n");
+    buf_put(&g.c, "#pragma GCC diagnostic ignored \"-Wtype-limits\"\n\n");
     for (int i = 0; i < u->pragmas.n; i++) buf_printf(&g.c, "%s\n", ((Token *)u->pragmas.v[i])->sval);
     /* types in dependency order */
     for (int i = 0; i < u->types.n; i++) {

@@ -12,7 +12,7 @@ int stc_compile(const Source *src, const char *outdir) {
     jmp_buf jb;
     error_count = 0;
     stc_error_jmp = &jb;
-    if (setjmp(jb)) { stc_error_jmp = NULL; return 1; }
+    if (setjmp(jb)) { stc_error_jmp = NULL; xfree_all(); return 1; }
     Unit u = {0};
     parse_unit(&u, &lib, true);
     int nlib = u.pous.n;
@@ -31,5 +31,6 @@ int stc_compile(const Source *src, const char *outdir) {
             rc = codegen(&u, outdir) ? 1 : 0;
     }
     stc_error_jmp = NULL;
+    xfree_all();
     return rc;
 }

@@ -151,7 +151,6 @@ static void lex_number(Lexer *L) {
         *w = 0;
         Token *t = add(L, TK_REAL, s, p);
         t->rval = strtod(txt, NULL);
-        free(txt);
         if (!isfinite(t->rval)) fatal_at(t->loc, "malformed real literal '%s': out of range", t->text);
     } else {
         if (ovf) fatal_at(here(L, s), "malformed integer literal '%.*s': too large", (int)(p - s), s);
@@ -384,7 +383,6 @@ Token *lex(const Source *src, int *count) {
                 else if (!strcmp(up, "TOD") || !strcmp(up, "TIME_OF_DAY")) k = TIMEK_TOD;
                 else if (!strcmp(up, "D") || !strcmp(up, "DATE")) k = TIMEK_DATE;
                 else if (!strcmp(up, "DT") || !strcmp(up, "DATE_AND_TIME")) k = TIMEK_DT;
-                free(up);
                 if (k >= 0) { lex_time(&L, p, e, (TimeKind)k); continue; }
             }
             add(&L, TK_IDENT, p, e);

@@ -270,8 +270,11 @@ static Node *unary(P *p) {
 }
 
 static Node *binary(P *p, Token *op, Node *l, Node *r) {
-    (void)p;
     Node *n = new_node(N_BINARY, op);
+    /* a long chain a+b+c+... nests as deeply as parentheses would */
+    n->depth = (l->depth > r->depth ? l->depth : r->depth) + 1;
+    if (n->depth + p->depth > MAX_DEPTH * 4)
+        fatal_at(op->loc, "expression too long (more than %d operators deep)", MAX_DEPTH * 4);
     n->op = op->up;
     if (!strcmp(n->op, "&")) n->op = "AND";
     n->lhs = l;
@@ -535,15 +538,16 @@ static bool var_block(P *p, Vec *out, bool global_ok) {
     else return false;
     if (cls == V_GLOBAL && !global_ok) fatal_at(t->loc, "VAR_GLOBAL is only allowed in a CONFIGURATION or RESOURCE");
     next(p);
-    bool constant = false, retain = false;
+    bool constant = false, retain = false, non_retain = false;
     for (;;) {
         if (accept_kw(p, "CONSTANT")) constant = true;
-        else if (accept_kw(p, "RETAIN")) retain = true;
-        else if (accept_kw(p, "NON_RETAIN")) retain = false;
+        else if (accept_kw(p, "RETAIN")) retain = true, non_retain = false;
+        else if (accept_kw(p, "NON_RETAIN")) retain = false, non_retain = true;
         else break;
     }
     int first = out->n;
     var_decls(p, out, cls, constant, retain, t, "END_VAR");
+    for (int i = first; i < out->n; i++) ((VarDecl *)out->v[i])->non_retain = non_retain;
     /* matiec wants located variables in VAR blocks of their own */
     for (int i = first + 1; i < out->n; i++) {
         VarDecl *a = out->v[first], *d = out->v[i];
@@ -690,6 +694,18 @@ static Node *statement(P *p) {
             n->rhs = expr(p);
             expect_p(p, ";");
             return n;
+        }
+        if ((target->kind == N_INDEX || target->kind == N_MEMBER) && is_p(cur(p), "(")) {
+            /* an instance reached through an array or a member: a[i](...) */
+            Token *open = next(p);
+            Node *call = new_node(N_CALL, open);
+            call->start = target->start;
+            call->loc = target->start;
+            call->lhs = target;
+            call->name = "instance";
+            call->uname = "";
+            call_args(p, call);
+            target = call;
         }
         if (target->kind == N_CALL) {
             n = new_node(S_CALL, t);

@@ -49,3 +49,8 @@ test-stc-fuzz: $(BUILD)/fuzz/fuzz_stc
 FUZZES += fuzz-stc
 fuzz-stc: $(BUILD)/fuzz/fuzz_stc
 	$(FUZZ_RUN) -max_total_time=$${FUZZ_SECONDS:-600}
+
+# ---- benchmarks ----
+BENCHES += bench-stc
+bench-stc: $(STC)
+	@bench/stc/run.sh $(abspath $(STC)) $(abspath $(STC_INC)) $(abspath $(BUILD))/bench/stc

@@ -746,6 +746,15 @@ static void check_writable(Ctx *c, Node *n) {
 }
 
 static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
+    if (n->lhs) {      /* a[i](...): the instance is an expression */
+        Type *it = check(c, n->lhs, NULL);
+        if (is_err(it)) return it;
+        if (canon(it)->kind != T_FB) { error_at(n->lhs->start, "this is not a function block instance, it is %s", type_name(it)); return err_type(); }
+        n->callee = canon(it)->pou;
+        n->name = n->callee->name;
+        check_call_args(c, n, n->callee, true);
+        return ty_prim[T_VOID];
+    }
     Sym *v = lookup_var(c, n->uname);
     if (v && v->kind == SK_VAR) {
         Type *t = canon(v->type);
@@ -863,7 +872,6 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
             error_at(call->loc, "missing parameter '%s' for '%s'", s->name, p->name);
     }
     (void)is_fb;
-    free(given);
 }
 
 /* ---- builtin functions ---- */
@@ -925,7 +933,6 @@ static bool order_builtin_args(Node *n, int id) {
         if (!ord[i]) { error_at(n->loc, "missing parameter for '%s'", n->name); return false; }
         n->list.v[i] = ord[i];
     }
-    free(ord);
     return true;
 }
 
@@ -1270,7 +1277,6 @@ static void check_stmt(Ctx *c, Node *s) {
             }
             check_stmts(c, &item->list2);
         }
-        free(seen.v);
         if (s->els) check_stmts(c, &s->els->list);
         return;
     }

@@ -15,6 +15,7 @@
 
 /* ---- memory and strings (util.c) ---- */
 void *xalloc(size_t n);                 /* zeroed; exits on exhaustion */
+void xfree_all(void);                   /* frees everything xalloc gave */
 char *xstrdup(const char *s);
 char *xstrndup(const char *s, size_t n);
 char *fmt(const char *f, ...) __attribute__((format(printf, 1, 2)));
@@ -113,6 +114,7 @@ struct Node {
     int64_t tval; TimeKind tkind;
     char *sval; int slen;
     bool is_out, negated;
+    int depth;        /* operator nesting below this node */
     /* filled by sema */
     Type *ty;
     Sym *sym;         /* resolved identifier / member */
@@ -145,7 +147,7 @@ typedef struct VarDecl {
     char *name, *uname;
     Loc loc;
     VarClass cls;
-    bool constant, retain;
+    bool constant, retain, non_retain;
     char *location;       /* "%QW3" or NULL */
     Loc locloc;
     TypeSpec *spec;

@@ -11,10 +11,24 @@
 int error_count;
 jmp_buf *stc_error_jmp;
 
+/* Every allocation of a compilation is chained here and freed at its end. */
+typedef struct Chunk { struct Chunk *next; max_align_t data[]; } Chunk;
+static Chunk *chunks;
+
 void *xalloc(size_t n) {
-    void *p = calloc(1, n ? n : 1);
-    if (!p) { fputs("stc: out of memory\n", stderr); exit(1); }
-    return p;
+    Chunk *c = calloc(1, sizeof(Chunk) + (n ? n : 1));
+    if (!c) { fputs("stc: out of memory\n", stderr); exit(1); }
+    c->next = chunks;
+    chunks = c;
+    return c->data;
+}
+
+void xfree_all(void) {
+    while (chunks) {
+        Chunk *n = chunks->next;
+        free(chunks);
+        chunks = n;
+    }
 }
 
 char *xstrndup(const char *s, size_t n) {
@@ -48,7 +62,6 @@ void vec_push(Vec *v, void *p) {
         v->cap = v->cap ? v->cap * 2 : 8;
         void **nv = xalloc(sizeof(void *) * (size_t)v->cap);
         if (v->n) memcpy(nv, v->v, sizeof(void *) * (size_t)v->n);
-        free(v->v);
         v->v = nv;
     }
     v->v[v->n++] = p;
@@ -58,8 +71,8 @@ static void buf_grow(Buf *b, size_t add) {
     if (b->n + add + 1 <= b->cap) return;
     size_t cap = b->cap ? b->cap : 256;
     while (cap < b->n + add + 1) cap *= 2;
-    char *s = realloc(b->s, cap);
-    if (!s) { fputs("stc: out of memory\n", stderr); exit(1); }
+    char *s = xalloc(cap);
+    if (b->n) memcpy(s, b->s, b->n + 1);
     b->s = s;
     b->cap = cap;
 }

@@ -12,7 +12,13 @@ test-stc-run: $(STC)
 test-stc-errors: $(STC)
 	@mkdir -p $(STC_TESTS)
 	@mk/suite.sh $(RESULTS) stc-errors env STC="$(STC)" \
-	    tests/stc/errors.sh $(STC_TESTS)/errors $(sort $(wildcard tests/stc/errors/*.st))
+	    tests/stc/errors.sh $(STC_TESTS)/errors \
+	    $(sort $(wildcard tests/stc/errors/*.st)) $(sort $(wildcard tests/stc/robust/*.st))
 
-TESTS += test-stc-run test-stc-errors
-.PHONY: test-stc-run test-stc-errors
+test-stc-contract: $(STC)
+	@mkdir -p $(STC_TESTS)
+	@mk/suite.sh $(RESULTS) stc-contract env STC="$(STC)" STC_INC="$(STC_INC)" \
+	    CC="$(CC)" CFLAGS="$(CFLAGS)" tests/stc/contract.sh $(STC_TESTS)/contract
+
+TESTS += test-stc-run test-stc-errors test-stc-contract
+.PHONY: test-stc-run test-stc-errors test-stc-contract

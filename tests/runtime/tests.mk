@@ -3,8 +3,8 @@
 
 RT_T := $(BUILD)/tests/runtime
 RT_CHECK_LIBS := $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lm -lrt -lpthread)
-RT_SRC_MAP := $(addprefix plc_runtime/,mbmap.c config.c program.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c
-RT_SRC_CFG := $(addprefix plc_runtime/,config.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c
+RT_SRC_MAP := $(addprefix plc_runtime/,mbmap.c config.c program.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
+RT_SRC_CFG := $(addprefix plc_runtime/,config.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
 RT_SRC_RET := plc_runtime/retain.c plc_runtime/log.c
 
 define rt_unit

@@ -4,7 +4,10 @@
 # stc must exit with status 1, and its first "error:" line must be
 # "<file>:line:col: error: ..." containing the message text, followed by
 # the source line and a caret under the column.
-# Then inputs that must not crash or hang stc, generated into OUTDIR.
+# A file whose first line is (* MUST-FAIL ... *) only has to be rejected
+# with a file:line:col diagnostic, (* MAY-PASS ... *) may also be accepted;
+# neither may crash stc or take more than 5 s.
+# Then more such inputs, generated into OUTDIR.
 #   tests/stc/errors.sh OUTDIR file.st...
 # Environment: STC (compiler command). Prints PASS:/FAIL: lines.
 set -u
@@ -21,8 +24,28 @@ compile() {
     rc=$?
 }
 
+# ---- robustness: no crash, no hang ----
+# must_fail NAME FILE: exit status 1 with a file:line:col diagnostic.
+# may_pass NAME FILE: as above, or exit status 0.
+check_robust() {
+    local mode=$1 name=$2 file=$3
+    compile "$file"
+    if [ $rc -eq 124 ]; then fail "robust $name: stc did not finish within 5 s"; return; fi
+    if [ $rc -gt 128 ]; then fail "robust $name: stc killed by signal $((rc - 128))" "$(printf '%s\n' "$log" | tail -3)"; return; fi
+    if [ $rc -eq 0 ] && [ "$mode" = may_pass ]; then pass "robust $name (accepted)"; return; fi
+    if [ $rc -ne 1 ]; then fail "robust $name: exit status $rc, expected 1"; return; fi
+    if printf '%s\n' "$log" | grep -q "^$file:[0-9]*:[0-9]*: error: "; then
+        pass "robust $name"
+    else
+        fail "robust $name: no $file:line:col: error: line" "$(printf '%s\n' "$log" | head -c 300)"
+    fi
+}
 for f in "$@"; do
     head=$(head -n 1 "$f")
+    case $head in
+    "(* MUST-FAIL "*) check_robust must_fail "$f" "$f"; continue ;;
+    "(* MAY-PASS "*) check_robust may_pass "$f" "$f"; continue ;;
+    esac
     if [[ ! $head =~ ^\(\*\ EXPECT-ERROR\ ([0-9]+):([0-9]+)\ (.*[^ ])\ *\*\)$ ]]; then
         fail "$f: first line is not (* EXPECT-ERROR line:col message *)"; continue
     fi
@@ -47,7 +70,7 @@ for f in "$@"; do
     src=$(sed -n "${L}p" "$f" | tr -d '\r')
     caret=$(printf '%s\n' "$log" | awk -v n="$n" -v src="$src" -v col="$C" '
         NR <= n { next }
-        found { c = substr($0, p + col, 1); print (c == "^" ? "ok" : "caret"); exit }
+        found { c = substr($0, p + col - 1, 1); print (c == "^" ? "ok" : "caret"); exit }
         src != "" && (p = index($0, src)) > 0 { found = 1; next }
         src == "" && NR == n + 1 { p = 1; found = 1; next }
         END { if (!found) print "source" }')
@@ -58,22 +81,7 @@ for f in "$@"; do
     esac
 done
 
-# ---- inputs that must not crash or hang stc ----
-# must_fail NAME FILE: exit status 1 with a file:line:col diagnostic.
-# may_pass NAME FILE: as above, or exit status 0.
-check_robust() {
-    local mode=$1 name=$2 file=$3
-    compile "$file"
-    if [ $rc -eq 124 ]; then fail "robust $name: stc did not finish within 5 s"; return; fi
-    if [ $rc -gt 128 ]; then fail "robust $name: stc killed by signal $((rc - 128))" "$(printf '%s\n' "$log" | tail -3)"; return; fi
-    if [ $rc -eq 0 ] && [ "$mode" = may_pass ]; then pass "robust $name (accepted)"; return; fi
-    if [ $rc -ne 1 ]; then fail "robust $name: exit status $rc, expected 1"; return; fi
-    if printf '%s\n' "$log" | grep -q "^$file:[0-9]*:[0-9]*: error: "; then
-        pass "robust $name"
-    else
-        fail "robust $name: no $file:line:col: error: line" "$(printf '%s\n' "$log" | head -c 300)"
-    fi
-}
+# ---- generated inputs that must not crash or hang stc ----
 g=$out/robust
 mkdir -p "$g"
 rep() { local i; for ((i = 0; i < $2; i++)); do printf '%s' "$1"; done; }

@@ -84,7 +84,7 @@ static const struct tinfo tinfos[] = {
 };
 
 /* A located variable resolved from its IEC address, e.g. "%QW3". */
-struct var { const char *iec; const struct tinfo *t; void *p; };
+struct var { char iec[32]; const struct tinfo *t; void *p; };
 
 /* A value: integers exact on 64 bits (neg + magnitude), reals as double. */
 struct value { int neg; uint64_t mag; double real; int is_real; };
@@ -251,7 +251,8 @@ static int resolve(const char *iec, struct var *x)
         if (strcmp(name, iec)) continue;
         for (const struct tinfo *t = tinfos; t->name; t++)
             if (!strcmp(t->name, l->type)) {
-                x->iec = iec; x->t = t; x->p = l->p;
+                snprintf(x->iec, sizeof x->iec, "%s", iec);
+                x->t = t; x->p = l->p;
                 return 0;
             }
         return -2;
@@ -329,7 +330,6 @@ static int load_script(const char *path)
                                                      : "has a type the harness does not know");
             bad = 1; continue;
         }
-        s->var.iec = strdup(tok[2]);
         if (parse_value(tok[3], &s->val)) { report(0, "%d: bad value '%s'", line, tok[3]); bad = 1; continue; }
         if (s->op == OP_EXPECT_REAL) {
             char *e;

@@ -1,0 +1,594 @@
+/* io_canopen.c: the `canopen` I/O backend of plcrt. Nodes and bindings come
+ * from the configuration file ([canopen] and [canopen.NAME] sections, see
+ * docs/canopen.md); the master itself is the frame-level core (co_master.h)
+ * on a SocketCAN raw socket.
+ * Scan thread: read_inputs drains the socket, advances time-outs and copies
+ * the TPDO data received since the last cycle into the %I areas;
+ * write_outputs packs the %Q areas into RPDOs and sends them, then SYNC.
+ * Messages the master produces in the scan are queued and printed by a
+ * small logging thread (the scan never waits on it longer than a copy). */
+#include <errno.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include "io_backend.h"
+#include "log.h"
+#include "co_master.h"
+#include "co_socketcan.h"
+
+#define MAX_NODES 32
+#define MAX_BINDS 256
+#define LOGQ 64
+
+typedef struct bind {
+    uint8_t node;           /* index in nodes[] */
+    uint8_t tx;             /* 1: input from a TPDO, 0: output to an RPDO */
+    uint8_t pdo;            /* 0..3 */
+    uint8_t bits;           /* width of the mapped object */
+    uint16_t off;           /* bit offset of the object in the PDO (+ bit) */
+    int8_t bit;             /* -1: whole object; 0..63: one bit of it */
+    uint16_t index;
+    uint8_t sub;
+    plc_loc loc;
+} bind;
+
+typedef struct nodecfg_ex {
+    char name[32];
+    int has_id, pdo_given;  /* pdo_given: some rpdoN/tpdoN key was set */
+    plc_loc status, ok;
+    int has_status, has_ok;
+} nodecfg_ex;
+
+typedef struct st {
+    char ifname[32];
+    unsigned sync_every;
+    unsigned boot_ms, sdo_ms, wait_ms;
+    int nnodes;
+    co_node nodes[MAX_NODES];
+    nodecfg_ex ex[MAX_NODES];
+    int nbinds;
+    bind binds[MAX_BINDS];
+    int fd;
+    int link_down;
+    co_frame pending;
+    int have_pending;
+    co_master m;
+    /* log queue: scan thread -> logging thread */
+    pthread_mutex_t lock;
+    pthread_t logger;
+    int logger_on, quit;
+    unsigned lq_head, lq_tail, lq_lost;
+    struct { int err; char msg[200]; } lq[LOGQ];
+    int direct_log;         /* main thread phases: print at once */
+} st;
+
+static co_time mono(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (co_time)ts.tv_sec * 1000000000ull + (co_time)ts.tv_nsec;
+}
+
+static void logcb(void *ctx, int err, const char *msg)
+{
+    st *s = ctx;
+    if (s->direct_log) {
+        plc_log(err ? LOG_ERROR : LOG_INFO, "canopen: %s", msg);
+        return;
+    }
+    pthread_mutex_lock(&s->lock);
+    if (s->lq_tail - s->lq_head < LOGQ) {
+        unsigned i = s->lq_tail++ % LOGQ;
+        s->lq[i].err = err;
+        snprintf(s->lq[i].msg, sizeof s->lq[i].msg, "%s", msg);
+    } else
+        s->lq_lost++;
+    pthread_mutex_unlock(&s->lock);
+}
+
+static void *logger(void *arg)
+{
+    st *s = arg;
+    for (;;) {
+        int err = 0, have = 0, quit;
+        unsigned lost = 0;
+        char msg[200];
+        pthread_mutex_lock(&s->lock);
+        if (s->lq_head != s->lq_tail) {
+            unsigned i = s->lq_head++ % LOGQ;
+            err = s->lq[i].err;
+            memcpy(msg, s->lq[i].msg, sizeof msg);
+            have = 1;
+        }
+        lost = s->lq_lost;
+        s->lq_lost = 0;
+        quit = s->quit;
+        pthread_mutex_unlock(&s->lock);
+        if (have)
+            plc_log(err ? LOG_ERROR : LOG_INFO, "canopen: %s", msg);
+        if (lost)
+            plc_log(LOG_WARN, "canopen: %u messages dropped", lost);
+        if (!have) {
+            if (quit)
+                return NULL;
+            usleep(20000);
+        }
+    }
+}
+
+static void *create(void)
+{
+    st *s = calloc(1, sizeof *s);
+    if (!s)
+        return NULL;
+    strcpy(s->ifname, "can0");
+    s->sync_every = 1;
+    s->boot_ms = 2000;
+    s->sdo_ms = 500;
+    s->wait_ms = 5000;
+    s->fd = -1;
+    pthread_mutex_init(&s->lock, NULL);
+    return s;
+}
+
+static int num(const char *v, unsigned long max, unsigned long *out, char *err, size_t n)
+{
+    char *end;
+    errno = 0;
+    unsigned long x = strtoul(v, &end, 0);
+    while (*end == ' ' || *end == '\t')
+        end++;
+    if (errno || end == v || *end || *v == '-' || x > max) {
+        snprintf(err, n, "'%s' is not a number in 0..%lu", v, max);
+        return -1;
+    }
+    *out = x;
+    return 0;
+}
+
+/* "0x6200:01" -> index, sub */
+static int parse_obj(const char **p, uint16_t *index, uint8_t *sub)
+{
+    char *end;
+    unsigned long i = strtoul(*p, &end, 16);
+    if (end == *p || *end != ':' || i > 0xFFFF)
+        return -1;
+    const char *q = end + 1;
+    unsigned long s = strtoul(q, &end, 16);
+    if (end == q || s > 0xFF)
+        return -1;
+    *index = (uint16_t)i;
+    *sub = (uint8_t)s;
+    *p = end;
+    return 0;
+}
+
+/* "0x6411:01:16 0x6411:02:16 ..." or "none" */
+static int parse_map(const char *v, co_pdo_map *m, char *err, size_t n)
+{
+    memset(m, 0, sizeof *m);
+    m->trans = 1;
+    if (!strcmp(v, "none"))
+        return 0;
+    const char *p = v;
+    while (*p) {
+        while (*p == ' ' || *p == ',' || *p == '\t')
+            p++;
+        if (!*p)
+            break;
+        if (m->n >= CO_PDO_MAX_ENTRIES) {
+            snprintf(err, n, "more than %d mapped objects", CO_PDO_MAX_ENTRIES);
+            return -1;
+        }
+        co_map_entry *e = &m->e[m->n];
+        char *end;
+        if (parse_obj(&p, &e->index, &e->sub) || *p != ':') {
+            snprintf(err, n, "'%s': expected entries INDEX:SUB:BITS (hex index and sub), or none", v);
+            return -1;
+        }
+        unsigned long b = strtoul(p + 1, &end, 10);
+        if (end == p + 1 || b < 1 || b > 64) {
+            snprintf(err, n, "'%s': the width of 0x%04X:%02X must be 1..64 bits", v, e->index, e->sub);
+            return -1;
+        }
+        e->bits = (uint8_t)b;
+        p = end;
+        m->n++;
+    }
+    return co_pdo_check(m, err, n);
+}
+
+static int node_of(st *s, const char *section, char *err, size_t n)
+{
+    for (int i = 0; i < s->nnodes; i++)
+        if (!strcmp(s->ex[i].name, section))
+            return i;
+    if (s->nnodes >= MAX_NODES) {
+        snprintf(err, n, "more than %d nodes", MAX_NODES);
+        return -1;
+    }
+    int i = s->nnodes++;
+    memset(&s->nodes[i], 0, sizeof s->nodes[i]);
+    co_node_cfg_cia401(&s->nodes[i].cfg, 0);
+    snprintf(s->ex[i].name, sizeof s->ex[i].name, "%s", section);
+    return i;
+}
+
+static int config(void *vs, const char *section, const char *key, const char *v, char *err, size_t n)
+{
+    st *s = vs;
+    unsigned long x;
+    if (!strcmp(section, "canopen")) {
+        if (!strcmp(key, "interface")) {
+            if (!*v || strlen(v) >= 16) {
+                snprintf(err, n, "'%s' is not an interface name", v);
+                return -1;
+            }
+            snprintf(s->ifname, sizeof s->ifname, "%s", v);
+            return 0;
+        }
+        unsigned *dst = !strcmp(key, "sync_every") ? &s->sync_every
+                      : !strcmp(key, "boot_timeout_ms") ? &s->boot_ms
+                      : !strcmp(key, "sdo_timeout_ms") ? &s->sdo_ms
+                      : !strcmp(key, "startup_wait_ms") ? &s->wait_ms : NULL;
+        if (!dst) {
+            snprintf(err, n, "unknown key (known: interface, sync_every, boot_timeout_ms, "
+                     "sdo_timeout_ms, startup_wait_ms)");
+            return -1;
+        }
+        if (num(v, 600000, &x, err, n))
+            return -1;
+        *dst = (unsigned)x;
+        return 0;
+    }
+    int i = node_of(s, section, err, n);
+    if (i < 0)
+        return -1;
+    co_node_cfg *c = &s->nodes[i].cfg;
+    nodecfg_ex *ex = &s->ex[i];
+    if (!strcmp(key, "id")) {
+        if (num(v, 127, &x, err, n) || x < 1) {
+            snprintf(err, n, "node id '%s' must be 1..127", v);
+            return -1;
+        }
+        c->id = (uint8_t)x;
+        ex->has_id = 1;
+        return 0;
+    }
+    if (!strcmp(key, "device_type")) {
+        if (num(v, 0xFFFFFFFFul, &x, err, n))
+            return -1;
+        c->device_type = (uint32_t)x;
+        c->check_type = 1;
+        return 0;
+    }
+    if (!strcmp(key, "heartbeat_producer_ms") || !strcmp(key, "heartbeat_consumer_ms")) {
+        if (num(v, 65535, &x, err, n))
+            return -1;
+        if (key[10] == 'p')
+            c->hb_producer_ms = (uint16_t)x;
+        else
+            c->hb_consumer_ms = (uint16_t)x;
+        return 0;
+    }
+    if ((!strncmp(key, "rpdo", 4) || !strncmp(key, "tpdo", 4)) && key[4] >= '1' && key[4] <= '4' && !key[5]) {
+        int tx = key[0] == 't';
+        co_pdo_map *m = tx ? &c->tpdo[key[4] - '1'] : &c->rpdo[key[4] - '1'];
+        if (!ex->pdo_given) {               /* the first PDO key drops the defaults */
+            memset(c->rpdo, 0, sizeof c->rpdo);
+            memset(c->tpdo, 0, sizeof c->tpdo);
+            ex->pdo_given = 1;
+        }
+        return parse_map(v, m, err, n);
+    }
+    if (!strcmp(key, "status") || !strcmp(key, "ok")) {
+        plc_loc l;
+        int is_ok = key[0] == 'o';
+        if (plc_loc_parse(v, &l) || l.area != 'I' || (is_ok ? l.size != 'X' : l.size != 'W')) {
+            snprintf(err, n, "'%s' is not an input %s (e.g. %s)", v, is_ok ? "bit" : "word",
+                     is_ok ? "%IX10.0" : "%IW20");
+            return -1;
+        }
+        if (is_ok) { ex->ok = l; ex->has_ok = 1; } else { ex->status = l; ex->has_status = 1; }
+        return 0;
+    }
+    if (!strcmp(key, "bind")) {
+        /* "INDEX:SUB[.BIT] %LOC" */
+        bind *b = &s->binds[s->nbinds];
+        const char *p = v;
+        if (s->nbinds >= MAX_BINDS) {
+            snprintf(err, n, "more than %d bindings", MAX_BINDS);
+            return -1;
+        }
+        memset(b, 0, sizeof *b);
+        b->bit = -1;
+        if (parse_obj(&p, &b->index, &b->sub)) {
+            snprintf(err, n, "'%s': expected INDEX:SUB[.BIT] %%LOCATION, e.g. 0x6200:01 %%QB0", v);
+            return -1;
+        }
+        if (*p == '.') {
+            char *end;
+            unsigned long bit = strtoul(p + 1, &end, 10);
+            if (end == p + 1 || bit > 63) {
+                snprintf(err, n, "'%s': bit number must be 0..63", v);
+                return -1;
+            }
+            b->bit = (int8_t)bit;
+            p = end;
+        }
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (plc_loc_parse(p, &b->loc) || b->loc.area == 'M') {
+            snprintf(err, n, "'%s' is not an %%I or %%Q location", p);
+            return -1;
+        }
+        b->node = (uint8_t)i;
+        s->nbinds++;
+        return 0;
+    }
+    snprintf(err, n, "unknown key (known: id, device_type, heartbeat_producer_ms, "
+             "heartbeat_consumer_ms, rpdo1..4, tpdo1..4, bind, status, ok)");
+    return -1;
+}
+
+/* find the mapped object of a binding; 0 or -1 with a message */
+static int resolve(st *s, bind *b, char *err, size_t n)
+{
+    co_node_cfg *c = &s->nodes[b->node].cfg;
+    b->tx = b->loc.area == 'I';
+    for (unsigned k = 0; k < CO_PDO_PER_NODE; k++) {
+        const co_pdo_map *m = b->tx ? &c->tpdo[k] : &c->rpdo[k];
+        for (unsigned e = 0; e < m->n; e++)
+            if (m->e[e].index == b->index && m->e[e].sub == b->sub) {
+                b->pdo = (uint8_t)k;
+                b->bits = m->e[e].bits;
+                b->off = (uint16_t)co_pdo_offset(m, e);
+                unsigned w = b->loc.size == 'X' ? 1 : plc_loc_width(&b->loc) * 8;
+                if (b->bit >= 0) {
+                    if (b->bit >= b->bits || w != 1) {
+                        snprintf(err, n, "[%s] bind 0x%04X:%02X.%d: %s", s->ex[b->node].name,
+                                 b->index, b->sub, b->bit, w != 1 ? "a bit binds to an X location"
+                                 : "bit beyond the object's width");
+                        return -1;
+                    }
+                } else if (b->bits > w) {
+                    snprintf(err, n, "[%s] bind 0x%04X:%02X: %u-bit object does not fit a %u-bit location",
+                             s->ex[b->node].name, b->index, b->sub, b->bits, w);
+                    return -1;
+                }
+                return 0;
+            }
+    }
+    snprintf(err, n, "[%s] bind 0x%04X:%02X: object not mapped in any %s of node %u",
+             s->ex[b->node].name, b->index, b->sub, b->tx ? "TPDO (for an input)" : "RPDO (for an output)",
+             c->id);
+    return -1;
+}
+
+static void flush(st *s)
+{
+    for (;;) {
+        if (!s->have_pending && !co_master_pop(&s->m, &s->pending))
+            return;
+        s->have_pending = 1;
+        int r = co_can_send(s->fd, &s->pending);
+        if (r == 0)
+            return;                 /* controller queue full: next cycle */
+        s->have_pending = 0;
+        if (r < 0) {
+            if (!s->link_down) {
+                s->link_down = 1;
+                co_master_bus(&s->m, CO_BUS_DOWN, "interface down");
+            }
+            while (co_master_pop(&s->m, &s->pending))
+                ;                   /* drop: nothing reaches the bus */
+            return;
+        }
+    }
+}
+
+static void poll_bus(st *s)
+{
+    co_frame f;
+    co_time now = mono();
+    int r;
+    while ((r = co_can_recv(s->fd, &f)) == 1)
+        co_master_rx(&s->m, &f, now);
+    if (r < 0 || s->link_down) {
+        int up = co_can_link_up(s->fd, s->ifname);
+        if (up != 1 && !s->link_down) {
+            s->link_down = 1;
+            co_master_bus(&s->m, CO_BUS_DOWN, "interface down");
+        } else if (up == 1 && s->link_down) {
+            s->link_down = 0;
+            co_master_bus(&s->m, CO_BUS_OK, "interface up again");
+        }
+    }
+    co_master_tick(&s->m, now);
+}
+
+static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
+{
+    st *s = vs;
+    (void)tick;
+    if (!s->nnodes) {
+        snprintf(err, n, "no node configured (add a [canopen.NAME] section with id = ...)");
+        return -1;
+    }
+    for (int i = 0; i < s->nnodes; i++) {
+        if (!s->ex[i].has_id) {
+            snprintf(err, n, "[%s]: no id", s->ex[i].name);
+            return -1;
+        }
+        for (int j = 0; j < i; j++)
+            if (s->nodes[j].cfg.id == s->nodes[i].cfg.id) {
+                snprintf(err, n, "[%s] and [%s] both have id %u", s->ex[j].name, s->ex[i].name,
+                         s->nodes[i].cfg.id);
+                return -1;
+            }
+    }
+    for (int i = 0; i < s->nbinds; i++)
+        if (resolve(s, &s->binds[i], err, n))
+            return -1;
+    s->fd = co_can_open(s->ifname, err, n);
+    if (s->fd < 0)
+        return -1;
+    co_master_init(&s->m, s->nodes, s->nnodes, s->sync_every);
+    s->m.boot_timeout = (co_time)s->boot_ms * CO_MS;
+    s->m.sdo_timeout = (co_time)s->sdo_ms * CO_MS;
+    for (int i = 0; i < s->nnodes; i++)
+        s->nodes[i].sdo.timeout = s->m.sdo_timeout;
+    s->m.log = logcb;
+    s->m.log_ctx = s;
+    s->direct_log = 1;
+    /* start-up in the main thread: every node configured, or reported */
+    co_time t0 = mono();
+    co_master_start(&s->m, t0);
+    while (!co_master_settled(&s->m) && mono() - t0 < (co_time)s->wait_ms * CO_MS) {
+        flush(s);
+        co_can_wait(s->fd, 2000000);
+        poll_bus(s);
+    }
+    flush(s);
+    int up = 0;
+    for (int i = 0; i < s->nnodes; i++)
+        up += s->nodes[i].phase == CO_PH_RUN;
+    plc_log(up == s->nnodes ? LOG_INFO : LOG_ERROR, "canopen: %s: %d of %d nodes operational",
+            s->ifname, up, s->nnodes);
+    (void)img;
+    s->direct_log = 0;
+    if (pthread_create(&s->logger, NULL, logger, s) == 0)
+        s->logger_on = 1;
+    else
+        s->direct_log = 1;
+    return 0;
+}
+
+static int rd(void *vs, plc_image *img, uint64_t now_ns)
+{
+    st *s = vs;
+    (void)now_ns;
+    poll_bus(s);
+    for (int i = 0; i < s->nbinds; i++) {
+        bind *b = &s->binds[i];
+        co_node *nd = &s->nodes[b->node];
+        if (!b->tx || !(nd->rx_new & (1 << b->pdo)))
+            continue;
+        uint64_t v = co_bits_get(nd->rx[b->pdo], b->off, b->bits);
+        uint8_t *p = plc_loc_ptr(img, &b->loc);
+        if (b->bit >= 0)
+            *p = (uint8_t)(v >> b->bit & 1);
+        else if (b->loc.size == 'X')
+            *p = (uint8_t)(v & 1);
+        else {
+            unsigned w = plc_loc_width(&b->loc);
+            uint8_t tmp[8];
+            for (unsigned k = 0; k < 8; k++)
+                tmp[k] = (uint8_t)(v >> (8 * k));      /* image: host order (LE) */
+            memcpy(p, tmp, w);
+        }
+    }
+    for (int i = 0; i < s->nnodes; i++) {
+        co_node *nd = &s->nodes[i];
+        nd->rx_new = 0;
+        if (s->ex[i].has_status) {
+            uint16_t w = (uint16_t)(nd->fault | nd->phase << 8);
+            memcpy(plc_loc_ptr(img, &s->ex[i].status), &w, 2);
+        }
+        if (s->ex[i].has_ok)
+            *plc_loc_ptr(img, &s->ex[i].ok) = nd->phase == CO_PH_RUN && !s->link_down
+                                              && s->m.bus != CO_BUS_OFF;
+    }
+    return 0;
+}
+
+static int wr(void *vs, const plc_image *img)
+{
+    st *s = vs;
+    for (int i = 0; i < s->nbinds; i++) {
+        bind *b = &s->binds[i];
+        if (b->tx)
+            continue;
+        co_node *nd = &s->nodes[b->node];
+        const uint8_t *p = plc_loc_ptr((plc_image *)img, &b->loc);
+        if (b->bit >= 0) {
+            co_bits_put(nd->tx[b->pdo], b->off + (unsigned)b->bit, 1, *p & 1);
+            continue;
+        }
+        uint64_t v = 0;
+        if (b->loc.size == 'X')
+            v = *p & 1;
+        else
+            for (unsigned k = 0; k < plc_loc_width(&b->loc); k++)
+                v |= (uint64_t)p[k] << (8 * k);
+        co_bits_put(nd->tx[b->pdo], b->off, b->bits, v);
+    }
+    co_master_cycle(&s->m, mono());
+    flush(s);
+    return 0;
+}
+
+static void safe(void *vs, plc_image *img)
+{
+    st *s = vs;
+    (void)img;
+    if (s->fd < 0)
+        return;
+    for (int i = 0; i < s->nnodes; i++)
+        memset(s->nodes[i].tx, 0, sizeof s->nodes[i].tx);
+    s->m.sync.phase = s->m.sync.every ? s->m.sync.every - 1 : 0;   /* SYNC now */
+    co_master_cycle(&s->m, mono());
+    for (int k = 0; k < 50 && (s->have_pending || s->m.qh != s->m.qt); k++) {
+        flush(s);
+        usleep(1000);
+    }
+    plc_log(LOG_INFO, "canopen: outputs of all nodes set to 0");
+}
+
+static void close_(void *vs)
+{
+    st *s = vs;
+    if (s->logger_on) {
+        pthread_mutex_lock(&s->lock);
+        s->quit = 1;
+        pthread_mutex_unlock(&s->lock);
+        pthread_join(s->logger, NULL);
+    }
+    if (s->fd >= 0)
+        close(s->fd);
+    pthread_mutex_destroy(&s->lock);
+    free(s);
+}
+
+/* 4 bus registers, then 6 per node for the first 10 nodes (docs/canopen.md) */
+static size_t diag(void *vs, uint16_t *r, size_t max)
+{
+    st *s = vs;
+    size_t k = 0;
+#define PUT(v) do { if (k < max) r[k++] = (uint16_t)(v); } while (0)
+    int up = 0;
+    for (int i = 0; i < s->nnodes; i++)
+        up += s->nodes[i].phase == CO_PH_RUN;
+    PUT(s->m.bus);
+    PUT(s->m.busoff_count);
+    PUT(s->nnodes);
+    PUT(up);
+    for (int i = 0; i < s->nnodes && i < 10; i++) {
+        co_node *nd = &s->nodes[i];
+        PUT(nd->cfg.id | nd->phase << 8);
+        PUT(nd->fault);
+        PUT(nd->unexpected_boot);
+        PUT(nd->hb_lost);
+        PUT(nd->emcy_count);
+        PUT(nd->last_emcy.code);
+    }
+#undef PUT
+    return k;
+}
+
+const io_backend_ops io_canopen = {
+    "canopen", create, config, open_, rd, wr, safe, close_, diag
+};

@@ -1,0 +1,151 @@
+"""Real-bus tests of the CANopen master, run inside User-Mode Linux on vcan0
+(tests/canopen/uml_run.sh): the stand-alone master (co_testmaster, program
+"echo") against two python-canopen CiA 401 slaves, plus a node id nobody
+answers. Prints PASS/FAIL lines. The candump trace is kept on failure.
+
+    $PY tests/canopen/bus_test.py BUILD_DIR OUT_DIR
+"""
+import os
+import queue
+import subprocess
+import sys
+import threading
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from slave401 import Slave401, connect  # noqa: E402
+
+build, out = sys.argv[1], sys.argv[2]
+master_bin = os.path.join(build, "co_testmaster")
+results = []
+
+
+def report(name, ok, detail=""):
+    results.append(ok)
+    print(f"{'PASS' if ok else 'FAIL'}: canopen_bus/{name}" + (f": {detail}" if detail and not ok else ""),
+          flush=True)
+    if detail and ok:
+        print(f"  ({detail})", flush=True)
+
+
+def wait_for(cond, timeout):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.002)
+    return cond()
+
+
+class Master:
+    def __init__(self, args):
+        self.p = subprocess.Popen([master_bin] + args, stdout=subprocess.PIPE,
+                                  stderr=subprocess.STDOUT, text=True)
+        self.lines = []
+        self.q = queue.Queue()
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        for line in self.p.stdout:
+            self.lines.append((time.monotonic(), line.rstrip()))
+            print("   master:", line.rstrip(), flush=True)
+
+    def seen(self, text, since=0.0):
+        return next((t for t, l in self.lines if text in l and t >= since), None)
+
+    def wait(self, text, timeout, since=0.0):
+        wait_for(lambda: self.seen(text, since) is not None, timeout)
+        return self.seen(text, since)
+
+    def stop(self):
+        self.p.terminate()
+        self.p.wait(5)
+        time.sleep(0.2)
+
+
+dump = os.path.join(out, "candump.log")
+candump = subprocess.Popen(["candump", "-L", "vcan0"], stdout=open(dump, "w"))
+time.sleep(0.2)
+
+# 1. interface errors: one clear message naming the interface, status 2
+r = subprocess.run([master_bin, "-i", "vcan7", "-n", "2"], capture_output=True, text=True)
+report("no_such_interface", r.returncode == 2 and "CAN interface vcan7: no such interface" in r.stderr,
+       f"status {r.returncode}, {r.stderr.strip()!r}")
+
+net = connect("vcan0")
+s2 = Slave401(net, 2)
+s3 = Slave401(net, 3)
+HB_CONS = 0.250
+m = Master(["-i", "vcan0", "-n", "2,3,9", "-c", "10000", "-H", "100:250"])
+
+# 2. start-up: nodes 2 and 3 configured and started, node 9 reported
+ok = m.wait("start-up done", 8) is not None
+ok = ok and wait_for(lambda: s2.state == 5 and s3.state == 5, 1)
+report("startup", ok,
+       f"states {s2.state} {s3.state}")
+report("silent_node_reported",
+       m.seen("node 9 does not answer: SDO upload of object 0x1000:00 timed out") is not None)
+
+# 3. SDO configuration, read back from the slaves' dictionaries (CiA 401
+#    defaults, worked out by hand from CiA 301/401)
+want = {(0x1400, 1): 0x202, (0x1401, 1): 0x302, (0x1402, 1): 0x80000402,
+        (0x1800, 1): 0x182, (0x1801, 1): 0x282, (0x1800, 2): 1, (0x1400, 2): 1,
+        (0x1600, 0): 8, (0x1600, 1): 0x62000108, (0x1600, 8): 0x62000808,
+        (0x1601, 0): 4, (0x1601, 4): 0x64110410, (0x1A00, 1): 0x60000108,
+        (0x1A01, 0): 4, (0x1A01, 2): 0x64010210, (0x1017, 0): 100}
+bad = [f"0x{i:04X}:{s} = 0x{s2.get(i, s):X}" for (i, s), v in want.items() if s2.get(i, s) != v]
+report("sdo_configuration", not bad, ", ".join(bad))
+
+# 4. digital and analog round trips through the master's program
+for s, d, a in ((s2, 0xA5, -12345), (s3, 0x3C, 32767)):
+    s.set(0x6000, 1, d)
+    s.set(0x6000, 8, 0x81)
+    s.set(0x6401, 2, a)
+    t0 = time.monotonic()
+    ok = wait_for(lambda: s.get(0x6200, 1) == d and s.get(0x6200, 8) == 0x81
+                  and s.get(0x6411, 2) == a, 1.0)
+    report(f"roundtrip_node{s.id}", ok,
+           f"{(time.monotonic() - t0) * 1000:.1f} ms; out {s.get(0x6200, 1):#x} {s.get(0x6411, 2)}")
+
+# 5. node 3's heartbeat stops: its outputs safe and its fault flagged
+#    within two consumer periods; node 2 keeps exchanging
+t_stop = time.monotonic()
+s3.stop_heartbeat()
+t_lost = m.wait("node 3: heartbeat lost", 2 * HB_CONS + 0.5, since=t_stop)
+ok = wait_for(lambda: s3.get(0x6200, 1) == 0 and s3.get(0x6411, 2) == 0, 2 * HB_CONS)
+t_safe = time.monotonic()
+report("hb_lost_detected", t_lost is not None and t_lost - t_stop <= 2 * HB_CONS,
+       f"{(t_lost - t_stop) * 1000:.0f} ms after the stop" if t_lost else "not detected")
+report("hb_lost_outputs_safe", ok and t_safe - t_stop <= 2 * HB_CONS,
+       f"{(t_safe - t_stop) * 1000:.0f} ms after the stop")
+s2.set(0x6000, 1, 0x42)
+report("other_node_keeps_exchanging", wait_for(lambda: s2.get(0x6200, 1) == 0x42, 0.5))
+
+# 6. node 3 resets (power cycle): reconfigured, started, exchanging again
+t_reset = time.monotonic()
+s3.boot()
+ok = m.wait("node 3: configured", 3, since=t_reset) is not None
+s3.set(0x6000, 1, 0x77)
+ok = ok and wait_for(lambda: s3.state == 5 and s3.get(0x6200, 1) == 0x77, 1.0)
+report("reset_node_reconfigured", ok and s3.get(0x1601, 1) == 0x64110110 and s3.get(0x1017) == 100,
+       f"state {s3.state}, 0x1601:01 0x{s3.get(0x1601, 1):X}")
+report("unexpected_bootup_logged", m.seen("node 3: unexpected boot-up", t_reset) is not None)
+
+# 7. EMCY from node 2
+t_e = time.monotonic()
+s2.node.emcy.send(0x3210, 0x05, b"\x01\x02\x03\x04\x05")
+report("emcy_logged", m.wait("node 2: EMCY 0x3210 (voltage), error register 0x05", 1, t_e) is not None)
+
+m.stop()
+summary = {l.split(":")[0]: l for _, l in m.lines if l.startswith("node ")}
+n3 = summary.get("node 3", "")
+report("counters", "hb_lost 1" in n3 and "unexpected_boot 1" in n3 and "emcy 1" in summary.get("node 2", ""),
+       n3)
+net.disconnect()
+candump.terminate()
+candump.wait()
+if all(results):
+    os.remove(dump)
+else:
+    print(f"candump trace kept: {dump}")
+sys.exit(0 if all(results) else 1)

@@ -1,0 +1,117 @@
+"""A CAN-driven simulated axis positioned by EPICPOS, inside User-Mode Linux
+on vcan0: plcrt runs st/canopen_axis.st; node 4 (slave401.Axis) integrates
+its analog output into an encoder count sent back in a TPDO. The move to
+setpos must end within toll (checked on the node's own count and on posit);
+then the node's heartbeat stops: the axis goes to emergency (DAC 0) within
+two consumer periods, as seed 000's guarding error does.
+
+    $PY tests/canopen/plcrt_axis_test.py PLCRT OUT_DIR
+"""
+import os
+import signal
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from slave401 import Axis, connect  # noqa: E402
+from pymodbus.client import ModbusTcpClient  # noqa: E402
+
+plcrt, out = sys.argv[1], sys.argv[2]
+PORT = 15032
+SETPOS, TOLL, HB_CONS = 20000, 20, 0.250
+results = []
+
+
+def report(name, ok, detail=""):
+    results.append(ok)
+    print(f"{'PASS' if ok else 'FAIL'}: canopen_axis/{name}" + ("" if ok else f": {detail}"), flush=True)
+    if ok and detail:
+        print(f"  ({detail})", flush=True)
+
+
+def wait_for(cond, timeout):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.005)
+    return cond()
+
+
+cfg = os.path.join(out, "axis.ini")
+with open(cfg, "w") as f:
+    f.write(f"""[plc]
+log_level = info
+[io]
+backend = canopen
+[modbus]
+port = {PORT}
+[canopen]
+interface = vcan0
+[canopen.axis]
+id = 4
+device_type = 0x191
+heartbeat_producer_ms = 100
+heartbeat_consumer_ms = 250
+rpdo1 = 0x6411:01:16
+tpdo1 = 0x2000:00:32 0x6000:01:8
+bind = 0x2000:00 %ID0
+bind = 0x6000:01 %IB0
+bind = 0x6411:01 %QW0
+status = %IW30
+""")
+
+dump = os.path.join(out, "candump.log")
+candump = subprocess.Popen(["candump", "-L", "vcan0"], stdout=open(dump, "w"))
+net = connect("vcan0")
+axis = Axis(net, 4, maxvel=40000.0)
+log = open(os.path.join(out, "plcrt.log"), "w")
+plc = subprocess.Popen([plcrt, "-c", cfg], stdout=log, stderr=subprocess.STDOUT)
+mb = ModbusTcpClient("127.0.0.1", port=PORT)
+ok = wait_for(lambda: mb.connect(), 10) and wait_for(lambda: axis.state == 5, 5)
+report("startup", ok, f"node state {axis.state}")
+
+
+def hreg(addr, n=1):
+    rr = mb.read_holding_registers(addr, n, slave=1)
+    return None if rr.isError() else rr.registers
+
+
+def posit():
+    r = hreg(2048, 2)
+    if not r:
+        return None
+    v = r[0] << 16 | r[1]
+    return v - (1 << 32) if v & 0x80000000 else v
+
+
+time.sleep(0.3)
+mb.write_register(1024, 1, slave=1)                   # go
+t0 = time.monotonic()
+ok = wait_for(lambda: (hreg(1025) or [0])[0] & 1 == 1, 8)
+count = axis.get(0x2000)
+report("positioned_within_toll", ok and abs(count - SETPOS) <= TOLL and abs((posit() or 0) - SETPOS) <= TOLL,
+       f"st_toll after {time.monotonic() - t0:.2f} s, encoder {count}, posit {posit()}")
+time.sleep(0.3)
+count = axis.get(0x2000)
+report("holds_position", abs(count - SETPOS) <= TOLL and abs(axis.get(0x6411, 1)) < 3000,
+       f"encoder {count}, DAC {axis.get(0x6411, 1)}")
+
+t_stop = time.monotonic()
+axis.stop_heartbeat()
+ok = wait_for(lambda: (hreg(1025) or [0])[0] & 2 == 2, 2 * HB_CONS)
+report("node_lost_axis_emergency", ok and axis.get(0x6411, 1) == 0,
+       f"{(time.monotonic() - t_stop) * 1000:.0f} ms, state {hreg(1025)}, DAC {axis.get(0x6411, 1)}")
+
+plc.send_signal(signal.SIGTERM)
+plc.wait(10)
+mb.close()
+net.disconnect()
+candump.terminate()
+candump.wait()
+if all(results):
+    os.remove(dump)
+else:
+    print(f"candump trace kept: {dump}")
+sys.exit(0 if all(results) else 1)

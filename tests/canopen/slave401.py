@@ -1,0 +1,225 @@
+"""CiA 401 I/O module peers for the real-bus tests, on python-canopen.
+
+python-canopen's LocalNode gives the SDO server, the heartbeat producer and
+the object dictionary; the glue here adds what a CiA 401 module does beyond
+that: NMT reset commands restore the dictionary and re-send the boot-up,
+received RPDOs are unpacked into the dictionary by their mapping, and each
+SYNC is answered with the synchronous TPDOs. PDO packing is done here
+independently of the master's C code (plain integer arithmetic).
+"""
+import struct
+import threading
+import time
+
+import canopen
+from canopen.objectdictionary import ODArray, ODRecord, ODVariable, ObjectDictionary
+from canopen.objectdictionary import datatypes as dt
+
+CIA401_TYPE = 0x00000191
+
+
+def var(name, index, sub, dtype, access="rw", default=0):
+    v = ODVariable(name, index, sub)
+    v.data_type = dtype
+    v.access_type = access
+    v.default = default
+    return v
+
+
+def array(od, name, index, n, dtype, access="rw"):
+    a = ODArray(name, index)
+    a.add_member(var("count", index, 0, dt.UNSIGNED8, "ro", n))
+    for s in range(1, n + 1):
+        a.add_member(var(f"{name} {s}", index, s, dtype, access, 0))
+    od.add_object(a)
+
+
+def build_od(node_id, device_type=CIA401_TYPE, encoder=False):
+    """A CiA 401 dictionary: 8 digital input/output bytes, 4 analog inputs and
+    outputs (INTEGER16); with encoder=True also 0x2000 an INTEGER32 count."""
+    od = ObjectDictionary()
+    od.add_object(var("device type", 0x1000, 0, dt.UNSIGNED32, "ro", device_type))
+    od.add_object(var("error register", 0x1001, 0, dt.UNSIGNED8, "ro", 0))
+    od.add_object(var("producer heartbeat time", 0x1017, 0, dt.UNSIGNED16, "rw", 0))
+    name = ODVariable("device name", 0x1008, 0)
+    name.data_type = dt.VISIBLE_STRING
+    name.access_type = "const"
+    name.default = "CiA401 slave"
+    od.add_object(name)
+    for base, fc in ((0x1400, 0x200), (0x1800, 0x180)):
+        for i in range(4):
+            r = ODRecord(f"PDO comm {i}", base + i)
+            r.add_member(var("highest sub", base + i, 0, dt.UNSIGNED8, "ro", 2))
+            # power-on: PDO1/2 valid on their default COB-IDs, 3/4 invalid
+            cobid = fc + 0x100 * i + node_id + (0 if i < 2 else 0x80000000)
+            r.add_member(var("COB-ID", base + i, 1, dt.UNSIGNED32, "rw", cobid))
+            r.add_member(var("transmission type", base + i, 2, dt.UNSIGNED8, "rw", 255))
+            od.add_object(r)
+    for base in (0x1600, 0x1A00):
+        for i in range(4):
+            r = ODRecord(f"PDO map {i}", base + i)
+            r.add_member(var("count", base + i, 0, dt.UNSIGNED8, "rw", 0))
+            for s in range(1, 9):
+                r.add_member(var(f"object {s}", base + i, s, dt.UNSIGNED32, "rw", 0))
+            od.add_object(r)
+    array(od, "digital inputs", 0x6000, 8, dt.UNSIGNED8)
+    array(od, "digital outputs", 0x6200, 8, dt.UNSIGNED8)
+    array(od, "analog inputs", 0x6401, 4, dt.INTEGER16)
+    array(od, "analog outputs", 0x6411, 4, dt.INTEGER16)
+    if encoder:
+        od.add_object(var("encoder count", 0x2000, 0, dt.INTEGER32, "rw", 0))
+    return od
+
+
+class Slave401:
+    """A CiA 401 module on a canopen.Network."""
+
+    def __init__(self, network, node_id, device_type=CIA401_TYPE, encoder=False):
+        self.id = node_id
+        self.network = network
+        self.lock = threading.RLock()
+        self.node = canopen.LocalNode(node_id, build_od(node_id, device_type, encoder))
+        network.add_node(self.node)
+        # replace the library's NMT handling: ours restores the dictionary
+        # and sends the boot-up, as a real module does
+        network.unsubscribe(0, self.node.nmt.on_command)
+        network.subscribe(0, self._on_nmt)
+        network.subscribe(0x080, self._on_sync)
+        for i in range(4):
+            network.subscribe(0x200 + 0x100 * i + node_id, self._on_rpdo)
+        self.syncs = 0
+        self.rpdos = 0
+        self.on_sync = None          # hook run before the TPDOs go out
+        self.boot()
+
+    # -- dictionary access -------------------------------------------------
+    def get(self, index, sub=0):
+        obj = self.node._find_object(index, sub)
+        data = self.node.get_data(index, sub)
+        return obj.decode_raw(data)
+
+    def set(self, index, sub, value):
+        obj = self.node._find_object(index, sub)
+        with self.lock:
+            self.node.data_store.setdefault(index, {})[sub] = obj.encode_raw(value)
+
+    def _u32(self, index, sub):
+        return int.from_bytes(self.node.get_data(index, sub), "little")
+
+    # -- NMT ---------------------------------------------------------------
+    @property
+    def state(self):
+        return self.node.nmt._state
+
+    def boot(self, comm_only=False):
+        """Power-on / reset: dictionary to defaults, boot-up, pre-operational."""
+        nmt = self.node.nmt
+        nmt.stop_heartbeat()
+        with self.lock:
+            if comm_only:
+                for index in [i for i in self.node.data_store if 0x1000 <= i < 0x2000]:
+                    del self.node.data_store[index]
+            else:
+                self.node.data_store.clear()
+        nmt._state = 0
+        self.network.send_message(0x700 + self.id, [0])      # boot-up
+        nmt._state = 127
+        hb = self.get(0x1017)
+        if hb:
+            nmt.start_heartbeat(hb)
+
+    def _on_nmt(self, can_id, data, timestamp):
+        if len(data) < 2 or data[1] not in (0, self.id):
+            return
+        cmd = data[0]
+        if cmd in (0x81, 0x82):
+            self.boot(comm_only=(cmd == 0x82))
+            return
+        states = {0x01: 5, 0x02: 4, 0x80: 127}
+        if cmd in states:
+            self.node.nmt._state = states[cmd]
+            self.node.nmt.update_heartbeat()
+
+    def stop_heartbeat(self):
+        self.node.nmt.stop_heartbeat()
+
+    # -- PDOs ----------------------------------------------------------------
+    def _mapping(self, base, i):
+        n = self._u32(base + i, 0)
+        out = []
+        for s in range(1, n + 1):
+            m = self._u32(base + i, s)
+            out.append((m >> 16, (m >> 8) & 0xFF, m & 0xFF))
+        return out
+
+    def _on_rpdo(self, can_id, data, timestamp):
+        if self.state != 5:
+            return
+        for i in range(4):
+            cobid = self._u32(0x1400 + i, 1)
+            if cobid & 0x80000000 or (cobid & 0x7FF) != can_id:
+                continue
+            word = int.from_bytes(bytes(data), "little")
+            off = 0
+            with self.lock:
+                for index, sub, bits in self._mapping(0x1600, i):
+                    raw = (word >> off) & ((1 << bits) - 1)
+                    obj = self.node._find_object(index, sub)
+                    nbytes = max(1, (len(obj) + 7) // 8)
+                    self.node.data_store.setdefault(index, {})[sub] = raw.to_bytes(nbytes, "little")
+                    off += bits
+            self.rpdos += 1
+
+    def _on_sync(self, can_id, data, timestamp):
+        if can_id != 0x080:
+            return
+        self.syncs += 1
+        if self.state != 5:
+            return
+        if self.on_sync:
+            self.on_sync(self)
+        for i in range(4):
+            cobid = self._u32(0x1800 + i, 1)
+            trans = self._u32(0x1800 + i, 2)
+            if cobid & 0x80000000 or not 1 <= trans <= 240:
+                continue
+            word, off = 0, 0
+            with self.lock:
+                for index, sub, bits in self._mapping(0x1A00, i):
+                    raw = int.from_bytes(self.node.get_data(index, sub), "little")
+                    word |= (raw & ((1 << bits) - 1)) << off
+                    off += bits
+            self.network.send_message(cobid & 0x7FF, word.to_bytes((off + 7) // 8, "little"))
+
+
+class Axis(Slave401):
+    """A CAN-driven simulated axis: analog output 1 (0x6411:01, 32767 =
+    +10 V) is the speed reference of a drive reaching `maxvel` counts/s at
+    10 V; the position is integrated into the INTEGER32 encoder count
+    0x2000 at every SYNC; the cam input 0x6000:01 bit 0 is on while the count
+    lies within [cam_lo, cam_hi]."""
+
+    def __init__(self, network, node_id, maxvel=40000.0, cam=(10000, 12000)):
+        super().__init__(network, node_id, encoder=True)
+        self.maxvel = maxvel
+        self.cam = cam
+        self.pos = 0.0
+        self.last = None
+        self.on_sync = Axis._integrate
+
+    def _integrate(self):
+        now = time.monotonic()
+        if self.last is not None:
+            dac = self.get(0x6411, 1)
+            self.pos += dac / 32767.0 * self.maxvel * (now - self.last)
+        self.last = now
+        count = int(round(self.pos))
+        count = (count + 2**31) % 2**32 - 2**31
+        self.set(0x2000, 0, count)
+        self.set(0x6000, 1, 1 if self.cam[0] <= count <= self.cam[1] else 0)
+
+
+def connect(channel="vcan0"):
+    net = canopen.Network()
+    net.connect(interface="socketcan", channel=channel)
+    return net
