@@ -1,18 +1,17 @@
 # Benchmarks. Each prints its figures and the comparison it makes.
 
 BENCH_B := $(BUILD)/bench
-BENCH_PORT := 15040
 
 # plcrt: latency beside cyclictest, Modbus throughput, cost per cycle
 $(eval $(call plcrt_program,bench_empty,bench/runtime/empty.st))
 $(eval $(call plcrt_program,bench_empty250,bench/runtime/empty250.st))
-$(BENCH_B)/runtime/bandwidth-client: /usr/share/doc/libmodbus-dev/examples/bandwidth-client.c
+$(BENCH_B)/runtime/bandwidth-client: /usr/share/doc/libmodbus-dev/examples/bandwidth-client.c bench/part.mk
 	@mkdir -p $(@D)
-	sed 's/1502)/$(BENCH_PORT))/; s/n_loop = 100000;/n_loop = 5000;/' $< > $@.c
+	sed 's/1502)/atoi(getenv("MODBUS_PORT")))/; s/n_loop = 100000;/n_loop = 5000;/' $< > $@.c
 	$(CC) -O2 -w -o $@ $@.c $(shell pkg-config --cflags --libs libmodbus)
 
 .PHONY: bench-runtime
 bench-runtime: $(BUILD)/plc/bench_empty/plcrt $(BUILD)/plc/bench_empty250/plcrt $(BENCH_B)/runtime/bandwidth-client
 	python3 bench/runtime/bench.py $(BUILD)/plc/bench_empty/plcrt $(BUILD)/plc/bench_empty250/plcrt \
-	  $(BENCH_B)/runtime/bandwidth-client $(BENCH_PORT) $(abspath $(BENCH_B))/runtime
+	  $(BENCH_B)/runtime/bandwidth-client auto $(abspath $(BENCH_B))/runtime
 BENCHES += bench-runtime

@@ -104,15 +104,10 @@ static void cell_set(mb_shared *m, const cell *c, uint16_t v)
         x = (x & ~((uint64_t)0xffff << sh)) | ((uint64_t)v << sh);
         store(c->p, c->size, x);
     }
-    mb_rec *last = m->nlog ? &m->log[m->nlog - 1] : NULL;
-    /* coalesce runs of coils */
-    if (last && c->size == 1 && !(c->target & MB_REC_ITEM) && !(last->target & MB_REC_ITEM)
-        && last->target + last->len == c->target && last->len < sizeof last->data) {
-        last->data[last->len++] = *c->p;
-        return;
-    }
-    if (last && last->target == c->target) { memcpy(last->data, c->p, c->size); return; }
-    mb_rec *r = &m->log[m->nlog++];
+    uint32_t *ix = (c->target & MB_REC_ITEM) ? &m->item_idx[c->target & ~MB_REC_ITEM]
+                                              : &m->img_idx[c->target];
+    mb_rec *r = *ix ? &m->log[*ix - 1] : &m->log[m->nlog++];
+    if (!*ix) *ix = (uint32_t)m->nlog;
     r->target = c->target;
     r->len = (uint8_t)c->size;
     memcpy(r->data, c->p, c->size);
@@ -277,6 +272,11 @@ void mb_apply(mb_shared *m, plc_image *img)
 {
     pthread_mutex_lock(&m->lock);
     replay(m, (uint8_t *)img, 0);
+    for (size_t i = 0; i < m->nlog; i++) {
+        uint32_t t = m->log[i].target;
+        if (t & MB_REC_ITEM) m->item_idx[t & ~MB_REC_ITEM] = 0;
+        else m->img_idx[t] = 0;
+    }
     m->nlog = 0;
     pthread_mutex_unlock(&m->lock);
 }
@@ -340,7 +340,9 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
     pthread_mutexattr_setprotocol(&a, PTHREAD_PRIO_INHERIT);
     pthread_mutex_init(&m->lock, &a);
     pthread_mutexattr_destroy(&a);
-    if (c->nsymbols && !(m->items = calloc((size_t)c->nsymbols, sizeof *m->items))) {
+    if (c->nsymbols && (!(m->items = calloc((size_t)c->nsymbols, sizeof *m->items))
+                        || !(m->item_idx = calloc((size_t)c->nsymbols, sizeof *m->item_idx)))) {
+        free(m->items);
         free(m);
         snprintf(err, errlen, "out of memory");
         return NULL;
@@ -384,5 +386,6 @@ void mb_free(mb_shared *m)
     if (!m) return;
     pthread_mutex_destroy(&m->lock);
     free(m->items);
+    free(m->item_idx);
     free(m);
 }

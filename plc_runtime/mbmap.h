@@ -28,7 +28,7 @@
 #define MB_INPUT_IMG   1024    /* %IW */
 #define MB_DIAG_BASE   1024    /* input registers of diagnostics */
 #define MB_DIAG_N      128
-#define MB_LOG_MAX     4096    /* pending write records per cycle */
+#define MB_LOG_MAX     16384   /* pending writes: more than the writable cells */
 #define MB_PDU_MAX     253
 
 /* Diagnostics: input register offsets from MB_DIAG_BASE; 32-bit values,
@@ -65,8 +65,12 @@ typedef struct mb_shared {
     uint16_t diag[MB_DIAG_N];
     mb_item *items;
     size_t nitems;
+    /* pending writes, one record per element written since the last
+    ** cycle (a later write to the same element replaces the value) */
     mb_rec log[MB_LOG_MAX];
     size_t nlog;
+    uint32_t img_idx[sizeof(plc_image)];   /* image offset -> record + 1 */
+    uint32_t *item_idx;                    /* item -> record + 1 */
     _Atomic uint64_t requests, exceptions, clients, refused;
 } mb_shared;
 

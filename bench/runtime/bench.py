@@ -2,7 +2,8 @@
 """plcrt benchmarks: wake latency beside cyclictest, Modbus throughput under
 libmodbus's bandwidth-client, and the runtime's own cost per cycle.
 
-usage: bench.py PLCRT_1MS PLCRT_250US BANDWIDTH_CLIENT PORT WORKDIR"""
+usage: bench.py PLCRT_1MS PLCRT_250US BANDWIDTH_CLIENT PORT|auto WORKDIR
+(auto: a port free now, passed to bandwidth-client in MODBUS_PORT)"""
 import os
 import re
 import signal
@@ -11,7 +12,15 @@ import subprocess
 import sys
 import time
 
-P1, P250, BW, PORT, WORK = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5]
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+P1, P250, BW, WORK = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[5]
+PORT = free_port() if sys.argv[4] == "auto" else int(sys.argv[4])
+os.environ["MODBUS_PORT"] = str(PORT)
 SECONDS = int(os.environ.get("BENCH_SECONDS", "10"))
 os.makedirs(WORK, exist_ok=True)
 

@@ -46,7 +46,7 @@ START_TEST(variable_table)
     ck_assert_uint_eq(q->retain, 0);
     ck_assert_ptr_eq(plc_var_addr(q), plc_img.qw + 2 * 1023);   /* located: the image itself */
     ck_assert_ptr_null(plc_var_find(&plc_program_linked, "CONFIG0.RES0.INST0.NOPE"));
-    ck_assert_uint_eq(*plc_program_linked.ticktime, 5000000);
+    ck_assert_uint_eq(*plc_program_linked.ticktime, 20000000);
 }
 END_TEST
 

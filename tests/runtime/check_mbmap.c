@@ -269,17 +269,26 @@ START_TEST(symbols)
 }
 END_TEST
 
-START_TEST(log_full_is_busy)
+START_TEST(many_writes_between_cycles)
 {
-    uint16_t v[100] = {0};
-    int busy = 0;
-    for (int i = 0; i < 100 && !busy; i++) {
-        write_regs(0, 100, v);
-        if (rsp[0] == (16 | 0x80)) { ck_assert_uint_eq(rsp[1], 6); busy = 1; }
+    /* far more writes than cells between two cycles: never busy, last wins */
+    uint16_t v[123];
+    for (int i = 0; i < 2000; i++) {
+        for (int k = 0; k < 123; k++) v[k] = (uint16_t)(i + k);
+        write_regs((unsigned)(i % 8) * 1000, 123, v);
+        OK(16);
     }
-    ck_assert(busy);
+    uint8_t bits[1968];
+    for (int i = 0; i < 1968; i++) bits[i] = (uint8_t)(i & 1);
+    for (unsigned a = 0; a < 8192 - 1968; a += 1968) { write_coils(a, 1968, bits); OK(15); }
     cycle();
-    write_regs(0, 100, v); OK(16);
+    /* the last write at 0 (%QW0..122) was i = 1992: register k = 1992 + k */
+    ck_assert_int_eq(img_get16(img.qw, 0), 1992);
+    ck_assert_int_eq(img_get16(img.qw, 122), 1992 + 122);
+    /* at 5000 (%ML226 from its most significant word) i = 1997 */
+    ck_assert(img_get64(img.ml, 226) == (int64_t)((1997ULL << 48) | (1998ULL << 32) | (1999ULL << 16) | 2000ULL));
+    ck_assert_uint_eq(img.qx[1], 1);
+    ck_assert_uint_eq(img.qx[2], 0);
 }
 END_TEST
 
@@ -321,7 +330,7 @@ int main(void)
     tcase_add_test(t, holding_writes);
     tcase_add_test(t, fc23);
     tcase_add_test(t, symbols);
-    tcase_add_test(t, log_full_is_busy);
+    tcase_add_test(t, many_writes_between_cycles);
     tcase_add_test(t, symbol_errors);
     suite_add_tcase(s, t);
     SRunner *r = srunner_create(s);

@@ -50,16 +50,16 @@ test-runtime-image: $(RT_T)/check_image $(RT_T)/check_sim_block $(STC)
 	  $(STC) $(STC_INC) $(RT_T)/outside $(CC) $(PLC_GEN_CFLAGS) || rc=1; exit $$rc
 TESTS += test-runtime-image
 
-# integration: libmodbus's own random-test-client, pointed at our test port
-RT_PORT := 15020
+# integration: libmodbus's own random-test-client, pointed at the port the
+# test picks (free at run time, so that several runs may share a machine)
 RT_MB_EXAMPLES := /usr/share/doc/libmodbus-dev/examples
-$(RT_T)/random-test-client: $(RT_MB_EXAMPLES)/random-test-client.c
+$(RT_T)/random-test-client: $(RT_MB_EXAMPLES)/random-test-client.c tests/runtime/tests.mk
 	@mkdir -p $(@D)
-	sed 's/1502)/$(RT_PORT))/' $< > $@.c
+	sed 's/1502)/atoi(getenv("MODBUS_PORT")))/' $< > $@.c
 	$(CC) -O2 -w -o $@ $@.c $(shell pkg-config --cflags --libs libmodbus)
 
 .PHONY: test-runtime-integration
 test-runtime-integration: $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client
 	@mk/suite.sh $(RESULTS) runtime-integration python3 tests/runtime/test_plcrt.py \
-	  $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client $(RT_PORT) $(abspath $(RT_T))/integration
+	  $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client auto $(abspath $(RT_T))/integration
 TESTS += test-runtime-integration
