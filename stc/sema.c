@@ -101,6 +101,15 @@ static Sym *find(Vec *v, const char *uname) {
     return NULL;
 }
 
+static Sym *new_sym(SymKind k, char *name, char *uname, Loc loc) {
+    Sym *s = xalloc(sizeof *s);
+    s->kind = k;
+    s->name = name;
+    s->uname = uname;
+    s->loc = loc;
+    return s;
+}
+
 static Type *new_type(TypeKind k, const char *name, const char *cname) {
     Type *t = xalloc(sizeof *t);
     t->kind = k;
@@ -289,11 +298,7 @@ static Type *resolve(Ctx *c, TypeSpec *s, const char *declname) {
             for (int j = 0; j < t->fields.n; j++)
                 if (!strcmp(t->fields.v[j], v->up)) error_at(v->loc, "duplicate declaration of '%s'", v->text);
             vec_push(&t->fields, v->up);
-            Sym *e = xalloc(sizeof *e);
-            e->kind = SK_ENUMVAL;
-            e->name = v->text;
-            e->uname = v->up;
-            e->loc = v->loc;
+            Sym *e = new_sym(SK_ENUMVAL, v->text, v->up, v->loc);
             e->type = t;
             e->enum_index = i;
             vec_push(&c->enumvals, e);
@@ -1368,11 +1373,7 @@ static Sym *declare_var(Ctx *c, Vec *scope, VarDecl *d, Pou *p) {
         error_at(d->loc, "duplicate declaration of '%s': it is the function's own name", d->name);
         return NULL;
     }
-    Sym *s = xalloc(sizeof *s);
-    s->kind = SK_VAR;
-    s->name = d->name;
-    s->uname = d->uname;
-    s->loc = d->loc;
+    Sym *s = new_sym(SK_VAR, d->name, d->uname, d->loc);
     s->decl = d;
     s->cls = d->cls;
     s->constant = d->constant;
@@ -1406,11 +1407,7 @@ static void declare_pou_vars(Ctx *c, Pou *p) {
     if (p->kind == POU_FUNCTION) {
         p->rettype = resolve(c, p->ret, NULL);
         if (canon(p->rettype)->kind == T_FB) error_at(p->ret->loc, "a function cannot return a function block");
-        Sym *r = xalloc(sizeof *r);
-        r->kind = SK_VAR;
-        r->name = p->name;
-        r->uname = p->uname;
-        r->loc = p->loc;
+        Sym *r = new_sym(SK_VAR, p->name, p->uname, p->loc);
         r->type = p->rettype;
         r->cls = V_LOCAL;
         r->in_function = true;
@@ -1564,11 +1561,7 @@ void sema(Unit *u) {
             error_at(d->loc, "duplicate declaration of '%s'", d->name);
             continue;
         }
-        Sym *s = xalloc(sizeof *s);
-        s->kind = SK_TYPE;
-        s->name = d->name;
-        s->uname = d->uname;
-        s->loc = d->loc;
+        Sym *s = new_sym(SK_TYPE, d->name, d->uname, d->loc);
         s->decl = (VarDecl *)d;
         vec_push(&c.types, s);
     }
@@ -1589,11 +1582,7 @@ void sema(Unit *u) {
                 goto next_pou;
             }
         {
-            Sym *s = xalloc(sizeof *s);
-            s->kind = SK_POU;
-            s->name = p->name;
-            s->uname = p->uname;
-            s->loc = p->loc;
+            Sym *s = new_sym(SK_POU, p->name, p->uname, p->loc);
             s->pou = p;
             vec_push(&c.pous, s);
             if (p->kind != POU_FUNCTION) {
