@@ -1,8 +1,13 @@
-# Example PLC projects, each linked into its own plcrt.
+# Example PLC projects, each linked into its own plcrt (build/plc/NAME/plcrt).
+# `make run` starts the EPICPOS example; `make run-EXAMPLE` starts another.
 $(eval $(call plcrt_program,demo,examples/demo/demo.st))
-ALL += $(BUILD)/plc/demo/plcrt
+$(eval $(call plcrt_program,epicpos,$(ST_LIB) examples/epicpos/epicpos.st))
+$(eval $(call plcrt_program,multiaxis,$(ST_LIB) examples/multiaxis/multiaxis.st))
+$(eval $(call plcrt_program,preset,$(ST_LIB) examples/preset/preset.st))
+EXAMPLES := demo epicpos multiaxis preset
+ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 
-.PHONY: run-demo
-run-demo: $(BUILD)/plc/demo/plcrt
-	$(BUILD)/plc/demo/plcrt -c examples/demo/demo.ini
-RUN_DEMO := run-demo
+.PHONY: $(EXAMPLES:%=run-%)
+$(EXAMPLES:%=run-%): run-%: $(BUILD)/plc/%/plcrt
+	$(BUILD)/plc/$*/plcrt -c examples/$*/$*.ini
+RUN_DEMO := run-epicpos

@@ -43,9 +43,10 @@ $(BUILD)/fuzz/fuzz_stc: tests/fuzz/fuzz_stc.c $(STC_SRCS) stc/stc.h
 	$(FUZZ_CC) -g -O1 -std=c11 -D_DEFAULT_SOURCE -fsanitize=fuzzer,address,undefined -o $@ tests/fuzz/fuzz_stc.c $(filter-out stc/main.c,$(STC_SRCS)) -lm
 
 FUZZ_RUN = mkdir -p $(BUILD)/fuzz/corpus && ASAN_OPTIONS=detect_leaks=0 $(BUILD)/fuzz/fuzz_stc \
-	-rss_limit_mb=2048 -timeout=5 -max_len=4096 $(BUILD)/fuzz/corpus tests/fuzz/corpus
+	-rss_limit_mb=2048 -timeout=5 -max_len=4096 -artifact_prefix=$(BUILD)/fuzz/ \
+	$(BUILD)/fuzz/corpus tests/fuzz/corpus
 test-stc-fuzz: $(BUILD)/fuzz/fuzz_stc
-	@mk/suite.sh $(RESULTS) stc-fuzz sh -c '$(FUZZ_RUN) -max_total_time=30 -artifact_prefix=$(BUILD)/fuzz/ > $(BUILD)/fuzz/last.log 2>&1 \
+	@mk/suite.sh $(RESULTS) stc-fuzz sh -c '$(FUZZ_RUN) -max_total_time=30 > $(BUILD)/fuzz/last.log 2>&1 \
 	    && echo "PASS: stc survives 30 s of fuzzing" || { tail -n 30 $(BUILD)/fuzz/last.log; echo "FAIL: stc fuzzing found a crash (input in $(BUILD)/fuzz/)"; }'
 FUZZES += fuzz-stc
 fuzz-stc: $(BUILD)/fuzz/fuzz_stc
