@@ -61,3 +61,11 @@ class Process:
     def wait(self, text, timeout, since=0.0):
         wait_for(lambda: self.seen(text, since) is not None, timeout)
         return self.seen(text, since)
+
+
+def free_port():
+    """A TCP port free on 127.0.0.1 now (for a plcrt's Modbus server)."""
+    import socket
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
