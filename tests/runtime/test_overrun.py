@@ -42,9 +42,10 @@ try:
     ok = wait_for(mb.connect, 10, 0.05) and wait_for(lambda: md(1) is not None, 5, 0.05)
     report("plcrt serves Modbus", ok)
     # heavy: 20 million iterations take far longer than 2 ms on any machine
-    c0 = md(1)
     set_md(0, 20_000_000)
-    time.sleep(1.5)
+    time.sleep(0.2)
+    c0 = md(1)          # from here on every cycle is heavy
+    time.sleep(1.3)
     c1 = md(1)
     set_md(0, 0)
     report("Modbus is served while the program overruns", c1 is not None and c1 > c0, f"cycles {c0} -> {c1}")
@@ -66,7 +67,7 @@ heavy = (c1 - c0) if c1 is not None and c0 is not None else 0
 total = int(m.group(1)) if m else -1
 own = int(e.group(1)) if e else -1
 report("every heavy cycle is an overrun counted as the program's own",
-       rc == 0 and heavy >= 3 and own >= heavy - 2 and own <= total,
+       rc == 0 and heavy >= 3 and own >= heavy - 1 and own <= total,
        f"{heavy} heavy cycles, {total} overruns, {own} the program's own; exit {rc}")
 warn = re.search(r"overrun\(s\) \(total \d+, \d+ periods skipped, (\d+) with the program alone", out)
 report("the overrun warning says how many were the program's", warn is not None and int(warn.group(1)) >= 1,
