@@ -52,6 +52,19 @@ def example_ini(src, dst, port, retain, period=None):
     return dst
 
 
+def ini_section(path, name):
+    """The keys of one section of an INI file (as plcrt reads them)."""
+    keys, section = {}, ""
+    for line in open(path).read().splitlines():
+        line = line.split(";")[0].split("#")[0].strip()
+        if line.startswith("["):
+            section = line.strip("[]").strip()
+        elif "=" in line and section == name:
+            k, v = line.split("=", 1)
+            keys[k.strip()] = v.strip()
+    return keys
+
+
 class Plcrt:
     """One plcrt process; its stdout and stderr go to WORK/NAME-N.log."""
     count = 0

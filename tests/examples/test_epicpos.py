@@ -46,7 +46,9 @@ DEFAULTS = {"slQuotaPos": 2000, "slVelAsse": 50, "cnratio": 100000, "maxpos": 99
             "pgain": 10, "feedfw": 1000}
 
 MAXVEL_UMS = 100000 / 60.0      # maxvel, Um/min -> Um/s
-LAG = 0.02                      # sim drive time constant, s (epicpos.ini)
+SIM = exlib.ini_section(INI, "sim.axis0")
+LAG = float(SIM["lag"])         # the drive's time constant, s
+SIM_MAXVEL = float(SIM["maxvel"])   # counts/s at 10 V (1 count = 1 Um)
 TCAMP = 0.004                   # the seed's TCamp 0004 (1.6)
 
 
@@ -88,7 +90,7 @@ def model_overshoot(dist, vpct, taccdec, pgain, feedfw=1000):
             u = feedfw / 1000.0 * ff / MAXVEL_UMS + pgain / 1000.0 * (sp(t) - math.floor(x)) / (MAXVEL_UMS * TCAMP)
             u = max(-1.0, min(1.0, round(u * 32767) / 32767))
         for _ in range(10):
-            vm += (u * MAXVEL_UMS - vm) * (1 - math.exp(-0.0001 / LAG))
+            vm += (u * SIM_MAXVEL - vm) * (1 - math.exp(-0.0001 / LAG))
             x += vm * 0.0001
         peak = max(peak, x)
     return peak - dist
@@ -127,13 +129,15 @@ def start_move(m, quota):
 
 def follow(m, timeout, done=lambda s: s["still"] and s["toll"]):
     """Sample posit, vel and the plant while waiting for done(state);
-    returns (samples, last state). A sample: (t, posit, vel, sim position)."""
+    returns (samples, last state). A sample: (t, posit, vel, sim position,
+    [ofToll, ofAxeFermo], st_still)."""
     samples, t0 = [], time.monotonic()
     while True:
         posit, vel = m.md(POSIT, 2)
         pos, _ = m.sim(0)
         s = state(m)
-        samples.append((time.monotonic() - t0, posit, vel, pos))
+        outs = m.coils(OFTOLL, 2)
+        samples.append((time.monotonic() - t0, posit, vel, pos, outs, s["still"]))
         if done(s) or time.monotonic() - t0 > timeout:
             return samples, s
 
@@ -210,12 +214,16 @@ def t_first_move(m):
            f"posit {posit}, states {s}")
     report("epicpos: posit is the plant's position (1 count = 1 Um)", abs(posit - pos) <= 1,
            f"posit {posit}, plant {pos} counts")
-    cruise = [v for (_, p, v, _) in samples if 0.35 * quota < p < 0.65 * quota]
+    moving = [outs for (*_, outs, still) in samples if not still]
+    report("epicpos: while moving ofToll and ofAxeFermo are off",
+           len(moving) >= 5 and not any(o[0] or o[1] for o in moving),
+           f"{len(moving)} samples while moving, outputs seen {sorted(set(map(tuple, moving)))}")
+    cruise = [v for (_, p, v, *_) in samples if 0.35 * quota < p < 0.65 * quota]
     want = pct * 100000 // 100
     report(f"epicpos: cruising speed is slVelAsse % of maxvel (vel {want} Um/min +-5 %)",
            len(cruise) >= 5 and all(abs(v - want) <= 0.05 * want for v in cruise),
            f"{len(cruise)} samples in cruise: {sorted(set(cruise))}")
-    peak = max(p for (_, p, _, _) in samples)
+    peak = max(p for (_, p, *_) in samples)
     over = peak - quota
     pred = model_overshoot(quota, pct, 100, 10)
     report(f"epicpos: overshoot with the seed's tuning is the loop's own "
@@ -234,7 +242,7 @@ def t_stiff_no_overshoot(m):
     time.sleep(0.02)
     start_move(m, quota)
     samples, s = follow(m, 8.0)
-    peak = max(p for (_, p, _, _) in samples)
+    peak = max(p for (_, p, *_) in samples)
     report(f"epicpos: with pgain 100 (model overshoot {pred:.1f} Um) posit never passes quota + toll "
            f"while moving ({len(samples)} samples)",
            pred < 5 and peak <= quota + 5 and s["toll"], f"peak {peak}, quota {quota}, final {m.md(POSIT)}")
@@ -274,9 +282,12 @@ def t_stop_input(m):
     time.sleep(0.2)
     posit, s = m.md(POSIT), state(m)
     dx, _ = still_for(m, 0.3)
-    report("epicpos: STOP input during a move: the axis stops short of the quota and stays within toll",
-           moving and s["still"] and base < posit < quota - 1000 and not s["toll"] and dx <= 5,
-           f"from {base} to quota {quota}: stopped at {posit}, then {dx} counts, states {s}")
+    outs = m.coils(OFTOLL, 2)
+    report("epicpos: STOP input during a move: the axis stops short of the quota and stays within toll; "
+           "ofAxeFermo on, ofToll off",
+           moving and s["still"] and base < posit < quota - 1000 and not s["toll"] and dx <= 5
+           and outs == [False, True], f"from {base} to quota {quota}: stopped at {posit}, then {dx} counts, "
+           f"states {s}, ofToll/ofAxeFermo {outs}")
     # START again goes on to the quota
     m.set_md(P["taccdec"], 20)      # shorter ramps from here on
     start_move(m, quota)

@@ -29,7 +29,11 @@ PLCRT, INI, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
 RUN, PRSON, PRSOK = 0, 1, 2            # coils
 PRSPOS, STATUS = 0, 10                 # %MD0; %MD10..15 mode, posit, count0..2, searches
 TOLL = 2                               # the program's toll
-BANDS = {0: (19990, 19999), 1: (16999, 16999), 2: (21975, 22000)}
+SIM = exlib.ini_section(INI, "sim.axis0")
+CAM_LO, CAM_HI = int(SIM["cam_low"]), int(SIM["cam_high"])
+ZOFF, CPR = int(SIM["zero_offset"]), int(SIM["counts_per_rev"])
+ZERO = ZOFF + ((CAM_LO - 1 - ZOFF) // CPR) * CPR      # the last zero pulse below the cam: 17000
+BANDS = {0: (CAM_LO - 10, CAM_LO - 1), 1: (ZERO - 1, ZERO - 1), 2: (CAM_HI - 25, CAM_HI)}
 
 
 def status(m):
@@ -70,6 +74,9 @@ def main():
                 ends[mode] = dict(status(m), prsok=ok and ok2, prson=on or on2)
             last = s
             time.sleep(0.005)
+        report("preset: preset.ini's plant is the README's (cam 20000..22000, zero pulses at 1000 + 4000 k)",
+               (CAM_LO, CAM_HI, ZOFF, CPR, ZERO) == (20000, 22000, 1000, 4000, 17000),
+               f"cam {CAM_LO}..{CAM_HI}, zero pulses at {ZOFF} + {CPR} k, last below the cam {ZERO}")
         report("preset: three searches, one per mode, within 25 s", sorted(ends) == [0, 1, 2], sorted(ends))
         for mode in sorted(ends):
             e = ends[mode]
