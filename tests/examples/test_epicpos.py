@@ -14,9 +14,10 @@ the example's own tuning is predicted by the reference model below."""
 import math
 import os
 import shutil
-import signal
+import re
 import socket
 import struct
+import subprocess
 import sys
 import time
 
@@ -130,14 +131,14 @@ def start_move(m, quota):
 def follow(m, timeout, done=lambda s: s["still"] and s["toll"]):
     """Sample posit, vel and the plant while waiting for done(state);
     returns (samples, last state). A sample: (t, posit, vel, sim position,
-    [ofToll, ofAxeFermo], st_still)."""
+    [ofToll, ofAxeFermo], st_still), the coils read in one request (one cycle)."""
     samples, t0 = [], time.monotonic()
     while True:
         posit, vel = m.md(POSIT, 2)
         pos, _ = m.sim(0)
-        s = state(m)
-        outs = m.coils(OFTOLL, 2)
-        samples.append((time.monotonic() - t0, posit, vel, pos, outs, s["still"]))
+        b = m.coils(OFTOLL, ST["cntrev"] - OFTOLL + 1)
+        s = {n: b[c - OFTOLL] for n, c in ST.items()}
+        samples.append((time.monotonic() - t0, posit, vel, pos, b[:2], s["still"]))
         if done(s) or time.monotonic() - t0 > timeout:
             return samples, s
 
@@ -230,6 +231,67 @@ def t_first_move(m):
            f"(model {pred:.1f} Um, measured {over} Um, +-3)",
            abs(over - pred) <= 3, f"peak posit {peak}, quota {quota}")
     return samples
+
+
+def readme_commands():
+    """The mbpoll lines of examples/epicpos/README.md, by the start of their comment."""
+    readme = os.path.join(os.path.dirname(INI), "README.md")
+    setup, cmds = None, {}
+    for line in open(readme).read().splitlines():
+        line = line.strip()
+        if line.startswith("M="):
+            setup = line
+        elif line.startswith("$M") and "#" in line:
+            cmd, comment = line.split("#", 1)
+            cmds[comment.strip()] = cmd.strip()
+    return setup, cmds
+
+
+def mbpoll(setup, cmd, port):
+    """Run one README line as a user would (bash, mbpoll), on the test's port;
+    returns {address: value} of what it printed, and its whole output."""
+    script = setup.replace("-p 1502", f"-p {port}") + "\n" + cmd
+    r = subprocess.run(["bash", "-c", script], capture_output=True, text=True, timeout=20)
+    vals = {int(a): int(v) for a, v in re.findall(r"^\[(\d+)\]:\s+(-?\d+)", r.stdout, re.M)}
+    said = [ln.strip() for ln in (r.stdout + r.stderr).splitlines()
+            if ln.startswith("[") or "rror" in ln or "llegal" in ln]
+    return vals, f"`{cmd}` exit {r.returncode}: " + " | ".join(said)
+
+
+def t_readme(m, port):
+    """examples/epicpos/README.md's mbpoll session, as printed there."""
+    setup, cmds = readme_commands()
+    pick = {k: next((c for d, c in cmds.items() if d.startswith(k)), None)
+            for k in ("slQuotaPos", "START input", "posit", "ofToll", "refcnt")}
+    if not setup or None in pick.values():
+        report("epicpos: README's mbpoll session found", False, f"{setup} {cmds}")
+        return
+    _, out = mbpoll(setup, pick["slQuotaPos"], port)
+    quota = m.md(P["slQuotaPos"])
+    report("epicpos: README: mbpoll writes slQuotaPos := 5000", quota == 5000, out)
+    _, out = mbpoll(setup, pick["START input"], port)
+    _, s = follow(m, 8.0)
+    posit = m.md(POSIT)
+    report("epicpos: README: mbpoll START input on, then off: the axis goes to 5000",
+           s["toll"] and abs(posit - 5000) <= 5, f"posit {posit}; {out}")
+    settle(m)
+    vals, out = mbpoll(setup, pick["posit"], port)
+    got = list(vals.values())
+    report("epicpos: README: mbpoll reads posit and vel (at rest: |vel| within one count per 100 ms)",
+           len(got) == 2 and abs(got[0] - m.md(POSIT)) <= 1 and abs(got[1]) <= 600, out)
+    vals, out = mbpoll(setup, pick["ofToll"], port)
+    report("epicpos: README: mbpoll reads ofToll, ofAxeFermo (both on)", list(vals.values()) == [1, 1], out)
+    # a refused START, then the README's line for why. The register table
+    # puts refcnt (%MD48) at 2048 + 2 x 48 = 2144: this fails while the
+    # README's mbpoll line reads from 2146 (refcode, parerr, DAC value)
+    m.set_md(P["toll"], -1000000)
+    pulse(m, START)
+    time.sleep(0.1)
+    want = m.md(REFCNT, 3)
+    vals, out = mbpoll(setup, pick["refcnt"], port)
+    m.set_md(P["toll"], 5)
+    report("epicpos: README: the mbpoll line for refcnt, refcode, parerr reads them",
+           list(vals.values()) == want, f"expected {want} (%MD48..50, holding {MD + 2 * REFCNT}); {out}")
 
 
 def t_stiff_no_overshoot(m):
@@ -478,9 +540,10 @@ def t_readonly_values(m):
     time.sleep(0.1)
     p1, s = m.md(POSIT), state(m)
     dx, dp = still_for(m, 0.3)
+    x1 = m.sim(0)[0]
     report("epicpos: writing posit and state coils: rewritten by the program, the axis does not move",
-           abs(p1 - p0) <= 5 and not s["emrg"] and s["still"] and dx <= 5 and dp <= 5 and m.md(REFCNT) == r0,
-           f"posit {p0} -> {p1}, states {s}, plant moved {dx}")
+           abs(p1 - p0) <= 5 and not s["emrg"] and s["still"] and abs(x1 - x0) <= 5 and dp <= 5
+           and m.md(REFCNT) == r0, f"posit {p0} -> {p1}, states {s}, plant {x0} -> {x1}")
 
 
 def main_session():
@@ -492,6 +555,7 @@ def main_session():
     port = m.c.comm_params.port
     run("epicpos: start-up", t_startup, m)
     run("epicpos: first move", t_first_move, m)
+    run("epicpos: README session", t_readme, m, port)
     run("epicpos: stiff loop", t_stiff_no_overshoot, m)
     run("epicpos: manual inputs", t_manual, m)
     run("epicpos: STOP input", t_stop_input, m)
