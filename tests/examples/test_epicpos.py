@@ -442,6 +442,39 @@ def t_emergency(m):
            s["toll"] and abs(posit - quota) <= 5, f"posit {posit}, quota {quota}")
 
 
+def t_following_error(m):
+    """maxfollerr below the drive's lag error: st_foller and an emergency,
+    st_foller held 500 ms at least; RESUME and a START complete the move."""
+    settle(m)
+    m.set_md(P["maxfollerr"], 5)
+    base = m.md(POSIT)
+    quota = base + 4000
+    start_move(m, quota)
+    t_on = None
+    s = wait_for(lambda: (lambda s: s if s["foller"] else None)(state(m)), 2.0, 0.005)
+    t_on = time.monotonic()
+    if not s:
+        report("epicpos: following error beyond maxfollerr (5 counts) sets st_foller", False, state(m))
+        m.set_md(P["maxfollerr"], 10000)
+        return
+    time.sleep(0.25)
+    s1, dac, (x1, v1) = state(m), m.md(DACVAL), m.sim(0)
+    report("epicpos: following error beyond maxfollerr (5): st_foller, emergency, loop open, DAC 0, "
+           "the axis stops", s1["foller"] and s1["emrg"] and not s1["loopon"] and dac == 0 and v1 == 0
+           and x1 < quota - 1000, f"states {s1}, DAC {dac}, plant at {x1} ({v1} counts/s)")
+    off = wait_for(lambda: not m.coils(ST["foller"]), 3.0, 0.01)
+    held = time.monotonic() - t_on
+    report("epicpos: st_foller is held 500 ms at least, then clears (the error back within the limit)",
+           off and held >= 0.45, f"held {held:.2f} s")
+    m.set_md(P["maxfollerr"], 10000)
+    command(m, "RESUME")
+    start_move(m, quota)
+    _, s = follow(m, 8.0)
+    posit = m.md(POSIT)
+    report("epicpos: after RESUME, START completes the move", s["toll"] and abs(posit - quota) <= 5,
+           f"posit {posit}, quota {quota}")
+
+
 def t_command_coil(m):
     r0 = m.md(REFCNT)
     m.set_coil(CMD["LOOPON"], 1)
@@ -546,6 +579,56 @@ def t_readonly_values(m):
            and m.md(REFCNT) == r0, f"posit {p0} -> {p1}, states {s}, plant {x0} -> {x1}")
 
 
+def t_posit_commands(m):
+    """WRPOSIT and DELCNT rewrite posit; the axis itself stays where it is."""
+    settle(m)
+    x0 = m.sim(0)[0]
+    m.set_md(P["newposit"], 100000)
+    command(m, "WRPOSIT")
+    time.sleep(0.05)
+    p1 = m.md(POSIT)
+    m.set_md(P["delta"], -2345)
+    command(m, "DELCNT")
+    time.sleep(0.05)
+    p2 = m.md(POSIT)
+    dx, _ = still_for(m, 0.2)
+    x1 = m.sim(0)[0]
+    report("epicpos: WRPOSIT: posit := newposit (100000); DELCNT: posit + delta (-2345); the axis stays",
+           abs(p1 - 100000) <= 2 and p2 - p1 == -2345 and abs(x1 - x0) <= 5 and dx <= 5 and m.coils(ST["still"]),
+           f"posit {p1}, then {p2}; plant {x0} -> {x1}")
+    # a START goes to a quota in the new frame
+    quota = p2 + 1000
+    start_move(m, quota)
+    _, s = follow(m, 6.0)
+    posit, x2 = m.md(POSIT), m.sim(0)[0]
+    report("epicpos: after WRPOSIT/DELCNT a START moves by the difference in the new frame",
+           s["toll"] and abs(posit - quota) <= 5 and abs((x2 - x1) - (posit - p2)) <= 2,
+           f"posit {p2} -> {posit} (quota {quota}), plant {x1} -> {x2}")
+
+
+def t_calibration(m):
+    """CALON: the DAC outputs vout x 3276.7 (+ offset); the plant runs at that
+    fraction of its speed at 10 V. CALOFF: the axis stops where it is."""
+    settle(m)
+    m.set_md(P["vout"], 10)                     # 1.0 V
+    command(m, "CALON")
+    time.sleep(0.4)                             # 20 drive time constants
+    s, dac, vel = state(m), m.md(DACVAL), m.md(VEL)
+    xs, vs = m.sim(0)
+    want = 1.0 / 10 * SIM_MAXVEL
+    report(f"epicpos: CALON with vout 10: st_cal, DAC 3277 (1 V), the plant at {want:.1f} counts/s, "
+           f"vel {want * 60:.0f} Um/min", s["cal"] and abs(dac - 3276.7) <= 1 and abs(vs - want) <= 2
+           and abs(vel - want * 60) <= 700, f"states {s}, DAC {dac}, plant {vs} counts/s, vel {vel}")
+    command(m, "CALOFF")
+    time.sleep(0.3)
+    s, x1 = state(m), m.sim(0)[0]
+    dx, dp = still_for(m, 0.3)
+    report("epicpos: CALOFF: st_cal off, the axis stops where it is (no run back) and stays",
+           not s["cal"] and s["still"] and x1 >= xs and dx <= 5 and dp <= 5 and not s["emrg"],
+           f"states {s}, plant at CALOFF {xs}, 0.3 s later {x1}, then moved {dx}")
+    m.set_md(P["vout"], 0)
+
+
 def main_session():
     retain = os.path.join(WORK, "epicpos.retain")
     for f in os.listdir(WORK):
@@ -561,9 +644,12 @@ def main_session():
     run("epicpos: STOP input", t_stop_input, m)
     run("epicpos: parameter range", t_param_range, m)
     run("epicpos: emergency", t_emergency, m)
+    run("epicpos: following error", t_following_error, m)
     run("epicpos: command coils", t_command_coil, m)
     run("epicpos: bad Modbus input", t_bad_modbus, m, port)
     run("epicpos: read-only values", t_readonly_values, m)
+    run("epicpos: WRPOSIT and DELCNT", t_posit_commands, m)
+    run("epicpos: calibration", t_calibration, m)
     report("epicpos: plcrt still running after all of the above", p.alive(), p.output()[-300:])
     m.close()
     rc = p.stop()
