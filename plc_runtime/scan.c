@@ -137,6 +137,8 @@ void *scan_thread(void *arg)
             k += miss;
             atomic_store_explicit(&s->stats.overruns, LD(s->stats.overruns) + 1, memory_order_relaxed);
             atomic_store_explicit(&s->stats.missed, LD(s->stats.missed) + miss, memory_order_relaxed);
+            if (end - wake >= period)
+                atomic_store_explicit(&s->stats.overruns_exec, LD(s->stats.overruns_exec) + 1, memory_order_relaxed);
         }
     }
     return NULL;

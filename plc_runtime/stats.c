@@ -14,7 +14,7 @@ void stats_reset(plc_stats *s)
 {
     hist_reset(&s->exec);
     hist_reset(&s->lat);
-    ST(s->cycles, 0); ST(s->overruns, 0); ST(s->missed, 0); ST(s->io_errors, 0);
+    ST(s->cycles, 0); ST(s->overruns, 0); ST(s->overruns_exec, 0); ST(s->missed, 0); ST(s->io_errors, 0);
 }
 
 void stat_add(stat_hist *h, uint64_t ns)
@@ -69,6 +69,10 @@ void stats_print(FILE *f, const plc_stats *s, uint64_t tick)
             (unsigned long long)LD(s->cycles), tick / 1e3,
             (unsigned long long)LD(s->overruns), (unsigned long long)LD(s->missed),
             (unsigned long long)LD(s->io_errors));
+    if (LD(s->overruns))
+        fprintf(f, "  overruns: %llu with the program's execution alone over the period, %llu after a late wake-up\n",
+                (unsigned long long)LD(s->overruns_exec),
+                (unsigned long long)(LD(s->overruns) - LD(s->overruns_exec)));
     line(f, "wake latency", &s->lat);
     line(f, "execution", &s->exec);
 }

@@ -26,6 +26,9 @@ typedef struct stat_summary {
 typedef struct plc_stats {
     stat_hist exec, lat;
     _Atomic uint64_t cycles, overruns, missed, io_errors;
+    /* overruns in which the program's execution alone lasted a period or
+       more (too slow for the period); the others began with a late wake-up */
+    _Atomic uint64_t overruns_exec;
 } plc_stats;
 
 void stats_reset(plc_stats *s);

@@ -327,34 +327,42 @@ static void conversion(G *g, Buf *b, Node *n) {
     buf_put(b, "))");
 }
 
+/* "fn(a0, a1, ...)" from the first nargs arguments of call n; cast1, if
+   not NULL, converts the second one: "fn(a0, (cast1)(a1))". */
+static void call_fn(G *g, Buf *b, const char *fn, Node *n, int nargs, const char *cast1) {
+    buf_printf(b, "%s(", fn);
+    for (int i = 0; i < nargs; i++) {
+        if (i) buf_put(b, ", ");
+        if (i == 1 && cast1) buf_printf(b, "(%s)(", cast1);
+        expr(g, b, arg(n, i));
+        if (i == 1 && cast1) buf_put(b, ")");
+    }
+    buf_put(b, ")");
+}
+
 static void builtin(G *g, Buf *b, Node *n) {
     Type *t = ct(n->ty);
     int id = n->builtin;
+    char fn[64];
     switch (id) {
     case B_CONV: conversion(g, b, n); return;
     case B_TRUNC:
-        buf_printf(b, "__trunc_to_%s(", t->cname);
-        expr(g, b, arg(n, 0));
-        buf_put(b, ")");
+        snprintf(fn, sizeof fn, "__trunc_to_%s", t->cname);
+        call_fn(g, b, fn, n, 1, NULL);
         return;
     case B_ABS:
-        if (is_real(t)) buf_printf(b, "%s(", t->kind == T_REAL ? "fabsf" : "fabs");
-        else buf_printf(b, "__ABS_%s(", t->cname);
-        expr(g, b, arg(n, 0));
-        buf_put(b, ")");
+        if (is_real(t)) snprintf(fn, sizeof fn, "%s", t->kind == T_REAL ? "fabsf" : "fabs");
+        else snprintf(fn, sizeof fn, "__ABS_%s", t->cname);
+        call_fn(g, b, fn, n, 1, NULL);
         return;
     case B_SQRT: case B_LN: case B_LOG: case B_EXP: case B_SIN: case B_COS: case B_TAN:
     case B_ASIN: case B_ACOS: case B_ATAN:
-        buf_printf(b, "%s%s(", math_fn(id), t->kind == T_REAL ? "f" : "");
-        expr(g, b, arg(n, 0));
-        buf_put(b, ")");
+        snprintf(fn, sizeof fn, "%s%s", math_fn(id), t->kind == T_REAL ? "f" : "");
+        call_fn(g, b, fn, n, 1, NULL);
         return;
     case B_EXPT:
-        buf_printf(b, "__EXPT_%s(", t->cname);
-        expr(g, b, arg(n, 0));
-        buf_put(b, ", (LREAL)(");
-        expr(g, b, arg(n, 1));
-        buf_put(b, "))");
+        snprintf(fn, sizeof fn, "__EXPT_%s", t->cname);
+        call_fn(g, b, fn, n, 2, "LREAL");
         return;
     case B_MOVE: expr(g, b, arg(n, 0)); return;
     case B_SEL:
@@ -374,13 +382,8 @@ static void builtin(G *g, Buf *b, Node *n) {
         return;
     }
     case B_LIMIT:
-        buf_printf(b, "__LIMIT_%s(", t->cname);
-        expr(g, b, arg(n, 0));
-        buf_put(b, ", ");
-        expr(g, b, arg(n, 1));
-        buf_put(b, ", ");
-        expr(g, b, arg(n, 2));
-        buf_put(b, ")");
+        snprintf(fn, sizeof fn, "__LIMIT_%s", t->cname);
+        call_fn(g, b, fn, n, 3, NULL);
         return;
     case B_MUX:
         buf_printf(b, "__MUX_%s((LINT)(", t->cname);
@@ -389,15 +392,10 @@ static void builtin(G *g, Buf *b, Node *n) {
         for (int i = 1; i < n->list.n; i++) { if (i > 1) buf_put(b, ", "); expr(g, b, arg(n, i)); }
         buf_put(b, "})");
         return;
-    case B_SHL: case B_SHR: case B_ROL: case B_ROR: {
-        const char *nm = id == B_SHL ? "SHL" : id == B_SHR ? "SHR" : id == B_ROL ? "ROL" : "ROR";
-        buf_printf(b, "__%s_%s(", nm, t->cname);
-        expr(g, b, arg(n, 0));
-        buf_put(b, ", (LINT)(");
-        expr(g, b, arg(n, 1));
-        buf_put(b, "))");
+    case B_SHL: case B_SHR: case B_ROL: case B_ROR:
+        snprintf(fn, sizeof fn, "__%s_%s", id == B_SHL ? "SHL" : id == B_SHR ? "SHR" : id == B_ROL ? "ROL" : "ROR", t->cname);
+        call_fn(g, b, fn, n, 2, "LINT");
         return;
-    }
     case B_LEN:
         buf_put(b, "((INT)(");
         expr(g, b, arg(n, 0));

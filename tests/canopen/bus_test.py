@@ -6,56 +6,23 @@ answers. Prints PASS/FAIL lines. The candump trace is kept on failure.
     $PY tests/canopen/bus_test.py BUILD_DIR OUT_DIR
 """
 import os
-import queue
 import subprocess
 import sys
-import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from slave401 import Slave401, connect  # noqa: E402
+from slave401 import CanDump, Slave401, connect  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from peer import Process, Report, wait_for  # noqa: E402
 
 build, out = sys.argv[1], sys.argv[2]
 master_bin = os.path.join(build, "co_testmaster")
-results = []
+report = Report("canopen_bus")
 
 
-def report(name, ok, detail=""):
-    results.append(ok)
-    print(f"{'PASS' if ok else 'FAIL'}: canopen_bus/{name}" + (f": {detail}" if detail and not ok else ""),
-          flush=True)
-    if detail and ok:
-        print(f"  ({detail})", flush=True)
-
-
-def wait_for(cond, timeout):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.002)
-    return cond()
-
-
-class Master:
+class Master(Process):
     def __init__(self, args):
-        self.p = subprocess.Popen([master_bin] + args, stdout=subprocess.PIPE,
-                                  stderr=subprocess.STDOUT, text=True)
-        self.lines = []
-        self.q = queue.Queue()
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self):
-        for line in self.p.stdout:
-            self.lines.append((time.monotonic(), line.rstrip()))
-            print("   master:", line.rstrip(), flush=True)
-
-    def seen(self, text, since=0.0):
-        return next((t for t, l in self.lines if text in l and t >= since), None)
-
-    def wait(self, text, timeout, since=0.0):
-        wait_for(lambda: self.seen(text, since) is not None, timeout)
-        return self.seen(text, since)
+        super().__init__([master_bin] + args, "master")
 
     def stop(self):
         self.p.terminate()
@@ -63,8 +30,7 @@ class Master:
         time.sleep(0.2)
 
 
-dump = os.path.join(out, "candump.log")
-candump = subprocess.Popen(["candump", "-L", "vcan0"], stdout=open(dump, "w"))
+trace = CanDump(os.path.join(out, "candump.log"))
 time.sleep(0.2)
 
 # 1. interface errors: one clear message naming the interface, status 2
@@ -142,10 +108,5 @@ n3 = summary.get("node 3", "")
 report("counters", "hb_lost 1" in n3 and "unexpected_boot 1" in n3 and "emcy 1" in summary.get("node 2", ""),
        n3)
 net.disconnect()
-candump.terminate()
-candump.wait()
-if all(results):
-    os.remove(dump)
-else:
-    print(f"candump trace kept: {dump}")
-sys.exit(0 if all(results) else 1)
+trace.close(keep=not report.all_passed())
+sys.exit(0 if report.all_passed() else 1)

@@ -14,29 +14,15 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from slave401 import Axis, connect  # noqa: E402
+from slave401 import Axis, CanDump, connect  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from peer import Report, wait_for  # noqa: E402
 from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 plcrt, out = sys.argv[1], sys.argv[2]
 PORT = 15032
 SETPOS, TOLL, HB_CONS = 20000, 20, 0.250
-results = []
-
-
-def report(name, ok, detail=""):
-    results.append(ok)
-    print(f"{'PASS' if ok else 'FAIL'}: canopen_axis/{name}" + ("" if ok else f": {detail}"), flush=True)
-    if ok and detail:
-        print(f"  ({detail})", flush=True)
-
-
-def wait_for(cond, timeout):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.005)
-    return cond()
+report = Report("canopen_axis")
 
 
 cfg = os.path.join(out, "axis.ini")
@@ -62,8 +48,7 @@ bind = 0x6411:01 %QW0
 status = %IW30
 """)
 
-dump = os.path.join(out, "candump.log")
-candump = subprocess.Popen(["candump", "-L", "vcan0"], stdout=open(dump, "w"))
+trace = CanDump(os.path.join(out, "candump.log"))
 net = connect("vcan0")
 axis = Axis(net, 4, maxvel=40000.0)
 log = open(os.path.join(out, "plcrt.log"), "w")
@@ -108,10 +93,5 @@ plc.send_signal(signal.SIGTERM)
 plc.wait(10)
 mb.close()
 net.disconnect()
-candump.terminate()
-candump.wait()
-if all(results):
-    os.remove(dump)
-else:
-    print(f"candump trace kept: {dump}")
-sys.exit(0 if all(results) else 1)
+trace.close(keep=not report.all_passed())
+sys.exit(0 if report.all_passed() else 1)

@@ -10,34 +10,19 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from slave401 import Slave401, connect  # noqa: E402
+from slave401 import CanDump, Slave401, connect  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from peer import Process, Report, wait_for  # noqa: E402
 from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 plcrt, out = sys.argv[1], sys.argv[2]
 PORT = 15031
 HB_CONS = 0.250
 DIAG = 1024 + 64            # the backend's diagnostics registers
-results = []
-
-
-def report(name, ok, detail=""):
-    results.append(ok)
-    print(f"{'PASS' if ok else 'FAIL'}: canopen_plcrt/{name}" + ("" if ok else f": {detail}"), flush=True)
-    if ok and detail:
-        print(f"  ({detail})", flush=True)
-
-
-def wait_for(cond, timeout):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.002)
-    return cond()
+report = Report("canopen_plcrt")
 
 
 def ini(path, iface="vcan0"):
@@ -70,28 +55,11 @@ sync_every = 1
     return path
 
 
-class Plcrt:
-    def __init__(self, cfg):
-        self.p = subprocess.Popen([plcrt, "-c", cfg], stdout=subprocess.PIPE,
-                                  stderr=subprocess.STDOUT, text=True)
-        self.lines = []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self):
-        for line in self.p.stdout:
-            self.lines.append((time.monotonic(), line.rstrip()))
-            print("   plcrt:", line.rstrip(), flush=True)
-
-    def seen(self, text, since=0.0):
-        return next((t for t, l in self.lines if text in l and t >= since), None)
-
-    def wait(self, text, timeout, since=0.0):
-        wait_for(lambda: self.seen(text, since) is not None, timeout)
-        return self.seen(text, since)
+def Plcrt(cfg):
+    return Process([plcrt, "-c", cfg], "plcrt")
 
 
-dump = os.path.join(out, "candump.log")
-candump = subprocess.Popen(["candump", "-L", "vcan0"], stdout=open(dump, "w"))
+trace = CanDump(os.path.join(out, "candump.log"))
 time.sleep(0.2)
 
 # no such interface: one clear error naming it, status 2
@@ -176,10 +144,5 @@ report("shutdown_outputs_safe", code == 0 and ok, f"exit {code}, out 0x{s2.get(0
 
 mb.close()
 net.disconnect()
-candump.terminate()
-candump.wait()
-if all(results):
-    os.remove(dump)
-else:
-    print(f"candump trace kept: {dump}")
-sys.exit(0 if all(results) else 1)
+trace.close(keep=not report.all_passed())
+sys.exit(0 if report.all_passed() else 1)

@@ -7,7 +7,8 @@ received RPDOs are unpacked into the dictionary by their mapping, and each
 SYNC is answered with the synchronous TPDOs. PDO packing is done here
 independently of the master's C code (plain integer arithmetic).
 """
-import struct
+import os
+import subprocess
 import threading
 import time
 
@@ -223,3 +224,20 @@ def connect(channel="vcan0"):
     net = canopen.Network()
     net.connect(interface="socketcan", channel=channel)
     return net
+
+
+class CanDump:
+    """candump -L of the bus into path while the test runs; the trace is
+    kept only when a test failed (close(keep))."""
+
+    def __init__(self, path, channel="vcan0"):
+        self.path = path
+        self.p = subprocess.Popen(["candump", "-L", channel], stdout=open(path, "w"))
+
+    def close(self, keep):
+        self.p.terminate()
+        self.p.wait()
+        if keep:
+            print(f"candump trace kept: {self.path}")
+        else:
+            os.remove(self.path)

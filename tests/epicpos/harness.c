@@ -15,69 +15,15 @@
  * Only the generated code's contract is used (type widths, __LOCATED_VAR
  * lines, entry points), so it runs either compiler's output.
  */
-#include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
-typedef struct { long tv_sec; long tv_nsec; } ht_time;
-typedef struct { uint8_t len; uint8_t body[126]; } ht_string;
-#define HT_BOOL  uint8_t
-#define HT_BYTE  uint8_t
-#define HT_USINT uint8_t
-#define HT_SINT  int8_t
-#define HT_INT   int16_t
-#define HT_UINT  uint16_t
-#define HT_WORD  uint16_t
-#define HT_DINT  int32_t
-#define HT_UDINT uint32_t
-#define HT_DWORD uint32_t
-#define HT_LINT  int64_t
-#define HT_ULINT uint64_t
-#define HT_LWORD uint64_t
-#define HT_REAL  float
-#define HT_LREAL double
-
-ht_time __CURRENT_TIME;
-uint8_t __DEBUG;
-extern unsigned long long common_ticktime__;
-void config_init__(void);
-void config_run__(unsigned long tick);
-
-#define __LOCATED_VAR(type, name, ...) \
-    static HT_##type name##_store; HT_##type *name = &name##_store;
-#include "LOCATED_VARIABLES.h"
-#undef __LOCATED_VAR
-
-struct locvar { const char *area, *size, *addr; void *p; };
-static const struct locvar locvars[] = {
-#define __LOCATED_VAR(type, name, area, size, ...) \
-    { #area, #size, #__VA_ARGS__, &name##_store },
-#include "LOCATED_VARIABLES.h"
-#undef __LOCATED_VAR
-    { NULL, NULL, NULL, NULL }
-};
-
-/* storage of a located variable by area, size and address ("0" or "0,0") */
-static void *loc(const char *area, const char *size, const char *addr)
-{
-    for (const struct locvar *l = locvars; l->area; l++) {
-        char a[32];
-        size_t n = 0;
-        for (const char *c = l->addr; *c && n + 1 < sizeof a; c++)
-            if (*c != ' ') a[n++] = *c;
-        a[n] = 0;
-        if (!strcmp(l->area, area) && !strcmp(l->size, size) && !strcmp(a, addr))
-            return l->p;
-    }
-    return NULL;
-}
+#include "plc_harness.h"
 
 static uint32_t qd(int i)
 {
     char a[16];
-    snprintf(a, sizeof a, "%d", i);
-    uint32_t *p = loc("Q", "D", a);
+    snprintf(a, sizeof a, "%%QD%d", i);
+    uint32_t *p = located(a, NULL);
     return p ? *p : 0;
 }
 
@@ -89,7 +35,7 @@ int main(int argc, char **argv)
     }
     const char *prog = strrchr(argv[1], '/') ? strrchr(argv[1], '/') + 1 : argv[1];
     long maxticks = atol(argv[2]);
-    uint8_t *done = loc("Q", "X", "0,0");
+    uint8_t *done = located("%QX0.0", NULL);
     if (!done) {
         printf("FAIL: %s: no %%QX0.0 (done) in the program\n", prog);
         return 1;
@@ -98,11 +44,7 @@ int main(int argc, char **argv)
     long tick;
     for (tick = 0; tick < maxticks && !*done; tick++) {
         config_run__((unsigned long)tick);
-        __CURRENT_TIME.tv_nsec += (long)common_ticktime__;
-        while (__CURRENT_TIME.tv_nsec >= 1000000000L) {
-            __CURRENT_TIME.tv_nsec -= 1000000000L;
-            __CURRENT_TIME.tv_sec++;
-        }
+        tick_clock();
     }
     int failed = 0;
     if (!*done) {

@@ -23,7 +23,7 @@ for st in "$@"; do
         [ "$(basename "$f")" = POUS.c ] || srcs+=("$f")
     done
     # shellcheck disable=SC2086
-    if ! $CC $CFLAGS -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -o "$d/prog" -lm > "$d/cc.log" 2>&1; then
+    if ! $CC $CFLAGS -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -I "$here/../common" -o "$d/prog" -lm > "$d/cc.log" 2>&1; then
         echo "FAIL: epicpos/$name: the generated C does not build:"
         sed 's/^/    /' "$d/cc.log" | head -20
         status=1; continue

@@ -63,3 +63,10 @@ test-runtime-integration: $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-clien
 	@mk/suite.sh $(RESULTS) runtime-integration python3 tests/runtime/test_plcrt.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client auto $(abspath $(RT_T))/integration
 TESTS += test-runtime-integration
+# overruns: a program made too slow over Modbus, counted as its own
+$(eval $(call plcrt_program,rt_spin,tests/runtime/st/spin.st))
+.PHONY: test-runtime-overrun
+test-runtime-overrun: $(BUILD)/plc/rt_spin/plcrt
+	@mk/suite.sh $(RESULTS) runtime-overrun python3 tests/runtime/test_overrun.py \
+	  $(BUILD)/plc/rt_spin/plcrt $(abspath $(RT_T))/overrun
+TESTS += test-runtime-overrun

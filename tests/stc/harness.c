@@ -23,51 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Elementary types as the generated code declares them (same widths). */
-typedef struct { long tv_sec; long tv_nsec; } ht_time;
-typedef struct { uint8_t len; uint8_t body[126]; } ht_string;
-#define HT_BOOL  uint8_t
-#define HT_BYTE  uint8_t
-#define HT_USINT uint8_t
-#define HT_SINT  int8_t
-#define HT_INT   int16_t
-#define HT_UINT  uint16_t
-#define HT_WORD  uint16_t
-#define HT_DINT  int32_t
-#define HT_UDINT uint32_t
-#define HT_DWORD uint32_t
-#define HT_LINT  int64_t
-#define HT_ULINT uint64_t
-#define HT_LWORD uint64_t
-#define HT_REAL  float
-#define HT_LREAL double
-#define HT_TIME  ht_time
-#define HT_DATE  ht_time
-#define HT_TOD   ht_time
-#define HT_DT    ht_time
-#define HT_STRING ht_string
-
-/* What the runtime provides to the generated code. */
-ht_time __CURRENT_TIME;
-uint8_t __DEBUG;
-extern unsigned long long common_ticktime__;
-void config_init__(void);
-void config_run__(unsigned long tick);
-
-/* Storage and pointer for every located variable. */
-#define __LOCATED_VAR(type, name, ...) \
-    static HT_##type name##_store; HT_##type *name = &name##_store;
-#include "LOCATED_VARIABLES.h"
-#undef __LOCATED_VAR
-
-struct locvar { const char *type, *area, *size, *addr; void *p; };
-static const struct locvar locvars[] = {
-#define __LOCATED_VAR(type, name, area, size, ...) \
-    { #type, #area, #size, #__VA_ARGS__, &name##_store },
-#include "LOCATED_VARIABLES.h"
-#undef __LOCATED_VAR
-    { NULL, NULL, NULL, NULL, NULL }
-};
+#include "plc_harness.h"
 
 /* ---- values ---- */
 
@@ -242,22 +198,16 @@ static void report(int pass, const char *fmt, ...)
 
 static int resolve(const char *iec, struct var *x)
 {
-    for (const struct locvar *l = locvars; l->type; l++) {
-        char name[64];
-        size_t n = (size_t)snprintf(name, sizeof name, "%%%s%s", l->area, l->size);
-        for (const char *a = l->addr; *a && n + 1 < sizeof name; a++)
-            if (*a != ' ') name[n++] = *a == ',' ? '.' : *a;
-        name[n] = 0;
-        if (strcmp(name, iec)) continue;
-        for (const struct tinfo *t = tinfos; t->name; t++)
-            if (!strcmp(t->name, l->type)) {
-                snprintf(x->iec, sizeof x->iec, "%s", iec);
-                x->t = t; x->p = l->p;
-                return 0;
-            }
-        return -2;
-    }
-    return -1;
+    const char *type;
+    void *p = located(iec, &type);
+    if (!p) return -1;
+    for (const struct tinfo *t = tinfos; t->name; t++)
+        if (!strcmp(t->name, type)) {
+            snprintf(x->iec, sizeof x->iec, "%s", iec);
+            x->t = t; x->p = p;
+            return 0;
+        }
+    return -2;
 }
 
 static int parse_ticks(const char *s, long *from, long *to)
@@ -370,9 +320,7 @@ int main(int argc, char **argv)
         for (int i = 0; i < nsteps; i++)
             if (steps[i].op == OP_SET && steps[i].from == tick) write_var(&steps[i].var, &steps[i].val);
         config_run__((unsigned long)tick);
-        unsigned long long ns = (unsigned long long)__CURRENT_TIME.tv_nsec + common_ticktime__;
-        __CURRENT_TIME.tv_sec += (long)(ns / 1000000000ULL);
-        __CURRENT_TIME.tv_nsec = (long)(ns % 1000000000ULL);
+        tick_clock();
         for (int i = 0; i < nsteps; i++)
             if (steps[i].op != OP_SET && steps[i].from <= tick && tick <= steps[i].to) check(&steps[i], tick);
     }

@@ -23,7 +23,7 @@ one() {  # one program; output goes to stdout
         [ "$(basename "$f")" = POUS.c ] || srcs+=("$f")
     done
     # shellcheck disable=SC2086
-    if ! $CC $CFLAGS -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -o "$d/prog" -lm > "$d/cc.log" 2>&1; then
+    if ! $CC $CFLAGS -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -I "$here/../common" -o "$d/prog" -lm > "$d/cc.log" 2>&1; then
         echo "FAIL: $st: generated C does not compile:"
         sed 's/^/    /' "$d/cc.log" | head -30
         return
@@ -36,7 +36,7 @@ one() {  # one program; output goes to stdout
     fi
     [ -n "${SAN:-}" ] || return
     # shellcheck disable=SC2086
-    if ! $CC $CFLAGS $SAN -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -o "$d/prog-san" -lm > "$d/cc-san.log" 2>&1; then
+    if ! $CC $CFLAGS $SAN -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -I "$here/../common" -o "$d/prog-san" -lm > "$d/cc-san.log" 2>&1; then
         echo "FAIL: $st: sanitizer build does not compile:"
         sed 's/^/    /' "$d/cc-san.log" | head -30
         return

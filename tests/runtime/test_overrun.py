@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""plcrt told whose fault an overrun is: a program made too slow for its
+2 ms period over Modbus (tests/runtime/st/spin.st) overruns in every cycle,
+each counted as the program's own; plcrt keeps serving Modbus meanwhile and
+the cycles are back on time once the program is light again.
+
+usage: test_overrun.py PLCRT WORKDIR"""
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from peer import Report, free_port, wait_for  # noqa: E402
+from pymodbus.client import ModbusTcpClient  # noqa: E402
+
+PLCRT, WORK = sys.argv[1], sys.argv[2]
+report = Report("runtime-overrun")
+os.makedirs(WORK, exist_ok=True)
+port = free_port()
+cfg = os.path.join(WORK, "spin.ini")
+with open(cfg, "w") as f:
+    f.write(f"[io]\nbackend = none\n[modbus]\nbind = 127.0.0.1\nport = {port}\n")
+
+log = open(os.path.join(WORK, "spin.log"), "w+")
+plc = subprocess.Popen([PLCRT, "-c", cfg], stdout=log, stderr=log)
+mb = ModbusTcpClient("127.0.0.1", port=port, timeout=3)
+
+
+def md(i):
+    r = mb.read_holding_registers(2048 + 2 * i, 2, slave=1)
+    return None if r.isError() else r.registers[0] << 16 | r.registers[1]
+
+
+def set_md(i, v):
+    return not mb.write_registers(2048 + 2 * i, [v >> 16, v & 0xFFFF], slave=1).isError()
+
+
+try:
+    ok = wait_for(mb.connect, 10, 0.05) and wait_for(lambda: md(1) is not None, 5, 0.05)
+    report("plcrt serves Modbus", ok)
+    # heavy: 20 million iterations take far longer than 2 ms on any machine
+    set_md(0, 20_000_000)
+    time.sleep(0.2)
+    c0 = md(1)          # from here on every cycle is heavy
+    time.sleep(1.3)
+    c1 = md(1)
+    set_md(0, 0)
+    report("Modbus is served while the program overruns", c1 is not None and c1 > c0, f"cycles {c0} -> {c1}")
+    time.sleep(0.5)
+    c2 = md(1)
+    time.sleep(0.5)
+    c3 = md(1)
+    # light again: 0.5 s at 2 ms is 250 cycles; allow a loaded machine half
+    report("light again, the cycles are back on time", c3 - c2 >= 125, f"{c3 - c2} cycles in 0.5 s")
+finally:
+    plc.send_signal(signal.SIGTERM)
+    rc = plc.wait(10)
+    mb.close()
+log.seek(0)
+out = log.read()
+m = re.search(r"(\d+) overruns \(", out)
+e = re.search(r"overruns: (\d+) with the program's execution alone over the period, (\d+) after a late wake-up", out)
+heavy = (c1 - c0) if c1 is not None and c0 is not None else 0
+total = int(m.group(1)) if m else -1
+own = int(e.group(1)) if e else -1
+report("every heavy cycle is an overrun counted as the program's own",
+       rc == 0 and heavy >= 3 and own >= heavy - 1 and own <= total,
+       f"{heavy} heavy cycles, {total} overruns, {own} the program's own; exit {rc}")
+warn = re.search(r"overrun\(s\) \(total \d+, \d+ periods skipped, (\d+) with the program alone", out)
+report("the overrun warning says how many were the program's", warn is not None and int(warn.group(1)) >= 1,
+       "no such warning in the log" if warn is None else warn.group(0))
+if not report.all_passed():
+    print(out[-2000:])
+sys.exit(0 if report.all_passed() else 1)
