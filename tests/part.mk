@@ -22,3 +22,6 @@ test-stc-contract: $(STC)
 
 TESTS += test-stc-run test-stc-errors test-stc-contract
 .PHONY: test-stc-run test-stc-errors test-stc-contract
+
+# ---- examples: the example programs under plcrt, over Modbus ----
+include tests/examples/tests.mk

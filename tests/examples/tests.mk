@@ -1,0 +1,16 @@
+# The example programs (examples/) under the real plcrt, driven over Modbus
+# TCP by pymodbus as their READMEs describe. Each run uses the example's own
+# configuration with a port free at run time and a private retain file.
+EX_T := $(BUILD)/tests/examples
+EX_RUN = mk/suite.sh $(RESULTS) examples-$(1) python3 tests/examples/test_$(1).py \
+	  $(BUILD)/plc/$(1)/plcrt examples/$(1)/$(1).ini $(abspath $(EX_T))/$(1)
+
+.PHONY: test-examples
+test-examples: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/multiaxis/plcrt $(BUILD)/plc/preset/plcrt
+	@rm -rf $(EX_T) && mkdir -p $(EX_T)
+	@rc=0; \
+	$(call EX_RUN,epicpos) || rc=1; \
+	$(call EX_RUN,multiaxis) || rc=1; \
+	$(call EX_RUN,preset) || rc=1; \
+	exit $$rc
+TESTS += test-examples
