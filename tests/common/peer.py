@@ -30,13 +30,15 @@ class Report:
 
 
 def wait_for(cond, timeout, step=0.002):
-    """True as soon as cond() holds, False if it still does not after timeout s."""
+    """cond()'s first true value, polling every step s; after timeout s, the
+    value of a last call (false if it still does not hold)."""
     end = time.monotonic() + timeout
     while time.monotonic() < end:
-        if cond():
-            return True
+        v = cond()
+        if v:
+            return v
         time.sleep(step)
-    return bool(cond())
+    return cond()
 
 
 class Process:

@@ -4,12 +4,16 @@ pymodbus, poll for conditions, report PASS:/FAIL: lines."""
 import os
 import re
 import signal
-import socket
 import struct
 import subprocess
+import sys
 import time
 
 from pymodbus.client import ModbusTcpClient
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import peer  # noqa: E402
+from peer import free_port  # noqa: E402,F401
 
 MD = 2048            # holding register of %MD0; %MDn at MD + 2n
 DIAG = 1024          # plcrt's diagnostics (input registers)
@@ -23,12 +27,6 @@ def report(name, ok, why=""):
     print(("PASS: " if ok else "FAIL: ") + name + ("" if ok else ": " + str(why)), flush=True)
     failed += not ok
     return ok
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def example_ini(src, dst, port, retain, period=None):
@@ -175,11 +173,5 @@ class Mb:
 
 
 def wait_for(pred, timeout, poll=0.02):
-    """Poll pred() until it returns a true value or timeout seconds pass;
-    returns the last value."""
-    end = time.monotonic() + timeout
-    while True:
-        v = pred()
-        if v or time.monotonic() > end:
-            return v
-        time.sleep(poll)
+    """peer.wait_for, polling Modbus every 20 ms by default."""
+    return peer.wait_for(pred, timeout, poll)

@@ -18,11 +18,8 @@ import time
 
 from pymodbus.client import ModbusTcpClient
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from peer import free_port  # noqa: E402
 
 PLCRT, RANDOM_CLIENT, WORK = sys.argv[1], sys.argv[2], sys.argv[4]
 PORT = free_port() if sys.argv[3] == "auto" else int(sys.argv[3])
