@@ -175,3 +175,34 @@ class Mb:
 def wait_for(pred, timeout, poll=0.02):
     """peer.wait_for, polling Modbus every 20 ms by default."""
     return peer.wait_for(pred, timeout, poll)
+
+
+def stop_and_exit_check(name, m, p):
+    """Close the client and stop plcrt with SIGTERM: it must exit 0."""
+    m.close()
+    rc = p.stop()
+    report(f"{name}: SIGTERM: exit 0", rc == 0, f"rc {rc}")
+
+
+def finish(name, body):
+    """Run body(); an exception in the test itself is a failure; no plcrt
+    is left running; exit 1 if any check failed."""
+    try:
+        body()
+    except Exception as e:  # noqa: BLE001
+        report(f"{name}: run", False, repr(e))
+    finally:
+        Plcrt.kill_all()
+    sys.exit(1 if failed else 0)
+
+
+def start_example(name, plcrt, ini, work):
+    """plcrt on the example's configuration, with a free port and a fresh
+    retain file in work: (the Plcrt, its Modbus port)."""
+    os.makedirs(work, exist_ok=True)
+    for f in os.listdir(work):
+        if f.startswith(name):
+            os.unlink(os.path.join(work, f))
+    port = free_port()
+    retain = os.path.join(work, name + ".retain")
+    return Plcrt(plcrt, example_ini(ini, os.path.join(work, name + ".ini"), port, retain), work, name), port

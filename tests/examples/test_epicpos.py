@@ -129,6 +129,14 @@ def start_move(m, quota):
     pulse(m, START, lambda: not m.coils(ST["still"]))
 
 
+def move(m, quota, timeout):
+    """START to quota, follow the move until still in tolerance (or timeout):
+    (last state, posit)."""
+    start_move(m, quota)
+    _, s = follow(m, timeout)
+    return s, m.md(POSIT)
+
+
 def follow(m, timeout, done=lambda s: s["still"] and s["toll"]):
     """Sample posit, vel and the plant while waiting for done(state);
     returns (samples, last state). A sample: (t, posit, vel, sim position,
@@ -363,9 +371,7 @@ def t_stop_input(m):
            f"STOP at posit {p_stop} on the way from {base} to {quota}: stopped at {posit}, then moved {dx}, "
            f"states {s}, ofToll/ofAxeFermo {outs}")
     # START again goes on to the quota
-    start_move(m, quota)
-    _, s = follow(m, 8.0)
-    posit = m.md(POSIT)
+    s, posit = move(m, quota, 8.0)
     report("epicpos: START after a STOP reaches the quota", s["toll"] and abs(posit - quota) <= 5,
            f"posit {posit}, quota {quota}")
 
@@ -400,9 +406,7 @@ def t_param_range(m):
     m.set_md(P["toll"], -5)          # negative in range: its absolute value is used
     time.sleep(0.05)
     pe = m.md(PARERR)
-    start_move(m, quota)
-    _, s = follow(m, 6.0)
-    posit = m.md(POSIT)
+    s, posit = move(m, quota, 6.0)
     report("epicpos: toll corrected (-5 is in range): parerr 0, START reaches the quota within |toll|",
            pe == 0 and s["toll"] and abs(posit - quota) <= 5, f"parerr {pe}, posit {posit}, quota {quota}")
     m.set_md(P["toll"], 5)
@@ -446,9 +450,7 @@ def t_emergency(m):
     time.sleep(0.05)
     s = state(m)
     report("epicpos: RESUME: st_emrg off, loop closed again", not s["emrg"] and s["loopon"], s)
-    start_move(m, quota)
-    _, s = follow(m, 8.0)
-    posit = m.md(POSIT)
+    s, posit = move(m, quota, 8.0)
     report("epicpos: after RESUME, START repeats the positioning to the quota",
            s["toll"] and abs(posit - quota) <= 5, f"posit {posit}, quota {quota}")
 
@@ -479,9 +481,7 @@ def t_following_error(m):
            off and held >= 0.45, f"held {held:.2f} s")
     m.set_md(P["maxfollerr"], 10000)
     command(m, "RESUME")
-    start_move(m, quota)
-    _, s = follow(m, 8.0)
-    posit = m.md(POSIT)
+    s, posit = move(m, quota, 8.0)
     report("epicpos: after RESUME, START completes the move", s["toll"] and abs(posit - quota) <= 5,
            f"posit {posit}, quota {quota}")
 
@@ -678,9 +678,7 @@ def t_retain():
     m.set_md(P["toll"], 8)
     m.set_md(P["taccdec"], 30)
     m.set_md(P["toldly"], 5)
-    start_move(m, q1)
-    _, s = follow(m, 6.0)
-    posit0 = m.md(POSIT)
+    s, posit0 = move(m, q1, 6.0)
     m.set_md(P["slQuotaPos"], q2)          # written, not started
     command(m, "EMRG")                     # a state that must not come back
     # DAC 0 V: the axis stops where its last correction had taken it
@@ -710,9 +708,7 @@ def t_retain():
     dx, dp = still_for(m, 0.3)
     report("retain: after the restart the axis does not move by itself", dx == 0 and dp == 0,
            f"plant moved {dx}, posit moved {dp}")
-    start_move(m, q2)
-    _, s = follow(m, 8.0)
-    posit = m.md(POSIT)
+    s, posit = move(m, q2, 8.0)
     report("retain: START after the restart goes to the retained quota", s["toll"] and abs(posit - q2) <= 8,
            f"posit {posit}, retained quota {q2}")
 

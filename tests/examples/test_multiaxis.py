@@ -15,8 +15,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exlib import Mb, Plcrt, example_ini, free_port, report, wait_for  # noqa: E402
-import exlib  # noqa: E402
+from exlib import Mb, finish, report, start_example, stop_and_exit_check, wait_for  # noqa: E402
 
 PLCRT, INI, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
 RUN, ON = 0, 1                  # coils: run, axis 1..3 on the DAC (1..3)
@@ -61,14 +60,9 @@ def reached(log, axis, target):
 
 
 def main():
-    os.makedirs(WORK, exist_ok=True)
-    retain = os.path.join(WORK, "multiaxis.retain")
-    for f in os.listdir(WORK):
-        if f.startswith("multiaxis"):
-            os.unlink(os.path.join(WORK, f))
-    port = free_port()
-    p = Plcrt(PLCRT, example_ini(INI, os.path.join(WORK, "multiaxis.ini"), port, retain), WORK, "multiaxis")
-    try:
+    p, port = start_example("multiaxis", PLCRT, INI, WORK)
+
+    def body():
         m = Mb(port)
         quotas = m.md(QUOTAS, 3)
         report("multiaxis: the quota registers hold three different quotas, all beyond 1000 Um from 0",
@@ -121,14 +115,9 @@ def main():
         m.set_coil(RUN, 1)
         ok = wait_for(lambda: snapshot(m)["moves"] > b["moves"], 3.0)
         report("multiaxis: run coil on again: positioning resumes", bool(ok))
-        m.close()
-        rc = p.stop()
-        report("multiaxis: SIGTERM: exit 0", rc == 0, f"rc {rc}")
-    except Exception as e:  # noqa: BLE001
-        report("multiaxis: run", False, repr(e))
-    finally:
-        Plcrt.kill_all()
-    sys.exit(1 if exlib.failed else 0)
+        stop_and_exit_check("multiaxis", m, p)
+
+    finish("multiaxis", body)
 
 
 main()

@@ -23,14 +23,13 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exlib import Mb, Plcrt, example_ini, free_port, report, wait_for  # noqa: E402
-import exlib  # noqa: E402
+from exlib import Mb, finish, ini_section, report, start_example, stop_and_exit_check, wait_for  # noqa: E402
 
 PLCRT, INI, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
 RUN, PRSON, PRSOK = 0, 1, 2            # coils
 PRSPOS, STATUS = 0, 10                 # %MD0; %MD10..15 mode, posit, count0..2, searches
 TOLL = 2                               # the program's toll
-SIM = exlib.ini_section(INI, "sim.axis0")
+SIM = ini_section(INI, "sim.axis0")
 CAM_LO, CAM_HI = int(SIM["cam_low"]), int(SIM["cam_high"])
 ZOFF, CPR = int(SIM["zero_offset"]), int(SIM["counts_per_rev"])
 ZERO = ZOFF + ((CAM_LO - 1 - ZOFF) // CPR) * CPR      # the last zero pulse below the cam: 17000
@@ -43,14 +42,9 @@ def status(m):
 
 
 def main():
-    os.makedirs(WORK, exist_ok=True)
-    retain = os.path.join(WORK, "preset.retain")
-    for f in os.listdir(WORK):
-        if f.startswith("preset"):
-            os.unlink(os.path.join(WORK, f))
-    port = free_port()
-    p = Plcrt(PLCRT, example_ini(INI, os.path.join(WORK, "preset.ini"), port, retain), WORK, "preset")
-    try:
+    p, port = start_example("preset", PLCRT, INI, WORK)
+
+    def body():
         m = Mb(port)
         prspos = 1234                  # before the first PRESET (the axis first moves to count 8000)
         m.set_md(PRSPOS, prspos)
@@ -101,14 +95,9 @@ def main():
                    "the axis at -300", BANDS[0][0] <= s["count"][0] <= BANDS[0][1] and abs(s["posit"] + 300) <= TOLL, s)
         else:
             report("preset: a second mode 0 search", False, status(m))
-        m.close()
-        rc = p.stop()
-        report("preset: SIGTERM: exit 0", rc == 0, f"rc {rc}")
-    except Exception as e:  # noqa: BLE001
-        report("preset: run", False, repr(e))
-    finally:
-        Plcrt.kill_all()
-    sys.exit(1 if exlib.failed else 0)
+        stop_and_exit_check("preset", m, p)
+
+    finish("preset", body)
 
 
 main()
