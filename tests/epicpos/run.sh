@@ -6,28 +6,16 @@
 # A program's "(* MAXTICKS n *)" comment bounds its run (1 tick = 1 ms).
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
+. "$here/../common/st_build.sh"
 out=$1 lib=$2; shift 2
 status=0
 for st in "$@"; do
     name=$(basename "$st" .st)
     d="$out/$name"
-    rm -rf "$d" && mkdir -p "$d/c"
+    rm -rf "$d" && mkdir -p "$d"
     cat "$lib" "$here/tsupport.st" "$st" > "$d/all.st"
-    if ! $STC -T "$d/c" "$d/all.st" > "$d/stc.log" 2>&1; then
-        echo "FAIL: epicpos/$name: the compiler rejected it:"
-        sed 's/^/    /' "$d/stc.log" | head -20
-        status=1; continue
-    fi
-    srcs=()
-    for f in "$d"/c/*.c; do
-        [ "$(basename "$f")" = POUS.c ] || srcs+=("$f")
-    done
-    # shellcheck disable=SC2086
-    if ! $CC $CFLAGS -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -I "$here/../common" -o "$d/prog" -lm > "$d/cc.log" 2>&1; then
-        echo "FAIL: epicpos/$name: the generated C does not build:"
-        sed 's/^/    /' "$d/cc.log" | head -20
-        status=1; continue
-    fi
+    st_compile "$d/all.st" "$d" "epicpos/$name" || { status=1; continue; }
+    st_link "$d" "$here/harness.c" "$d/prog" "epicpos/$name" || { status=1; continue; }
     ticks=$(sed -n 's/.*(\* MAXTICKS \([0-9]*\) \*).*/\1/p' "$st" | head -1)
     timeout 300 "$d/prog" "$st" "${ticks:-100000}" || status=1
 done

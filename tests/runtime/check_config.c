@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "config.h"
+#include "../common/check_run.h"
 
 static plc_config c;
 static char err[700];
@@ -144,9 +145,5 @@ int main(void)
     tcase_add_test(t, first_error_wins);
     tcase_add_test(t, missing_file);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_ENV);
-    int f = srunner_ntests_failed(r);
-    srunner_free(r);
-    return f ? 1 : 0;
+    return check_run(s);
 }

@@ -3,6 +3,7 @@
 #include <check.h>
 #include "plc_image.h"
 #include "program.h"
+#include "../common/check_run.h"
 
 static void run(void) { plc_program_linked.run(0); }
 
@@ -57,9 +58,5 @@ int main(void)
     tcase_add_test(t, last_addresses);
     tcase_add_test(t, variable_table);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_ENV);
-    int f = srunner_ntests_failed(r);
-    srunner_free(r);
-    return f ? 1 : 0;
+    return check_run(s);
 }

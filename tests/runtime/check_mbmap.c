@@ -6,6 +6,7 @@
 #include <string.h>
 #include "config.h"
 #include "mbmap.h"
+#include "../common/check_run.h"
 
 static int32_t v_dint;          /* CONFIG0.RES0.INST0.D, holding 9000 rw */
 static int16_t v_int = 77;      /* CONFIG0.RES0.INST0.I, holding 9002 read-only */
@@ -333,9 +334,5 @@ int main(void)
     tcase_add_test(t, many_writes_between_cycles);
     tcase_add_test(t, symbol_errors);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_ENV);
-    int f = srunner_ntests_failed(r);
-    srunner_free(r);
-    return f ? 1 : 0;
+    return check_run(s);
 }

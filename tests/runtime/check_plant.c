@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include "../../c_blocks/plant.h"
+#include "../common/check_run.h"
 
 static plant s;
 
@@ -113,9 +114,5 @@ int main(void)
     tcase_add_test(t, resonance);
     tcase_add_test(t, cam);
     suite_add_tcase(su, t);
-    SRunner *r = srunner_create(su);
-    srunner_run_all(r, CK_ENV);
-    int f = srunner_ntests_failed(r);
-    srunner_free(r);
-    return f ? 1 : 0;
+    return check_run(su);
 }

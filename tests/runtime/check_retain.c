@@ -11,6 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "retain.h"
+#include "../common/check_run.h"
 
 static char dir[256], file[300];
 
@@ -246,9 +247,5 @@ int main(void)
     tcase_add_test(t, type_changed);
     tcase_add_test(t, kill9_loop);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_ENV);
-    int f = srunner_ntests_failed(r);
-    srunner_free(r);
-    return f ? 1 : 0;
+    return check_run(s);
 }

@@ -6,6 +6,7 @@
 #include <string.h>
 #include "io_backend.h"
 #include "program.h"
+#include "../common/check_run.h"
 
 extern const io_backend_ops io_sim;
 
@@ -51,9 +52,5 @@ int main(void)
     TCase *t = tcase_create("st");
     tcase_add_test(t, block_matches_backend);
     suite_add_tcase(s, t);
-    SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_ENV);
-    int f = srunner_ntests_failed(r);
-    srunner_free(r);
-    return f ? 1 : 0;
+    return check_run(s);
 }

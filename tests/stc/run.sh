@@ -7,27 +7,15 @@
 # Prints PASS:/FAIL: lines; exit status 1 when anything failed.
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
+. "$here/../common/st_build.sh"
 
 one() {  # one program; output goes to stdout
     local st=$1 out=$2
     local name; name=$(basename "$st" .st)
     local d="$out/$name"
-    rm -rf "$d" && mkdir -p "$d/c"
-    if ! $STC -T "$d/c" "$st" > "$d/stc.log" 2>&1; then
-        echo "FAIL: $st: stc rejected the program:"
-        sed 's/^/    /' "$d/stc.log" | head -20
-        return
-    fi
-    local srcs=() f
-    for f in "$d"/c/*.c; do
-        [ "$(basename "$f")" = POUS.c ] || srcs+=("$f")
-    done
-    # shellcheck disable=SC2086
-    if ! $CC $CFLAGS -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -I "$here/../common" -o "$d/prog" -lm > "$d/cc.log" 2>&1; then
-        echo "FAIL: $st: generated C does not compile:"
-        sed 's/^/    /' "$d/cc.log" | head -30
-        return
-    fi
+    rm -rf "$d"
+    st_compile "$st" "$d" "$st" || return
+    st_link "$d" "$here/harness.c" "$d/prog" "$st" || return
     timeout 20 "$d/prog" "$st" > "$d/run.log" 2>&1
     local rc=$?
     cat "$d/run.log"
@@ -36,11 +24,7 @@ one() {  # one program; output goes to stdout
     fi
     [ -n "${SAN:-}" ] || return
     # shellcheck disable=SC2086
-    if ! $CC $CFLAGS $SAN -I "$STC_INC" -I "$d/c" "${srcs[@]}" "$here/harness.c" -I "$here/../common" -o "$d/prog-san" -lm > "$d/cc-san.log" 2>&1; then
-        echo "FAIL: $st: sanitizer build does not compile:"
-        sed 's/^/    /' "$d/cc-san.log" | head -30
-        return
-    fi
+    st_link "$d" "$here/harness.c" "$d/prog-san" "$st: sanitizer build" $SAN || return
     ASAN_OPTIONS=exitcode=86:detect_leaks=0 UBSAN_OPTIONS=exitcode=86:print_stacktrace=1 \
         timeout 60 "$d/prog-san" -q "$st" > "$d/run-san.log" 2>&1
     local src=$?

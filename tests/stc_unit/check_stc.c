@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "../../stc/stc.h"
+#include "../common/check_run.h"
 
 static Source src_of(const char *text) {
     Source s = {"test.st", text, strlen(text)};
@@ -327,9 +328,5 @@ static Suite *stc_suite(void) {
 }
 
 int main(void) {
-    SRunner *r = srunner_create(stc_suite());
-    srunner_run_all(r, CK_ENV);
-    int failed = srunner_ntests_failed(r);
-    srunner_free(r);
-    return failed ? 1 : 0;
+    return check_run(stc_suite());
 }
