@@ -34,6 +34,7 @@ void scan_diag(scan *s, uint16_t *d)
     put32(d, MBD_CYCLES, LD(st->cycles));
     put32(d, MBD_OVERRUNS, LD(st->overruns));
     put32(d, MBD_MISSED, LD(st->missed));
+    put32(d, MBD_OVERRUNS_EXEC, LD(st->overruns_exec));
     n = LD(st->exec.n);
     if (n) {
         put32(d, MBD_EXEC_MIN, LD(st->exec.min_ns) / 1000);

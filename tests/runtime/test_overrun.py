@@ -47,6 +47,8 @@ try:
     c0 = md(1)          # from here on every cycle is heavy
     time.sleep(1.3)
     c1 = md(1)
+    r = mb.read_input_registers(1024 + 40, 2, slave=1)
+    own_mb = None if r.isError() else r.registers[0] << 16 | r.registers[1]
     set_md(0, 0)
     report("Modbus is served while the program overruns", c1 is not None and c1 > c0, f"cycles {c0} -> {c1}")
     time.sleep(0.5)
@@ -69,6 +71,8 @@ own = int(e.group(1)) if e else -1
 report("every heavy cycle is an overrun counted as the program's own",
        rc == 0 and heavy >= 3 and own >= heavy - 1 and own <= total,
        f"{heavy} heavy cycles, {total} overruns, {own} the program's own; exit {rc}")
+report("the diagnostics register 1064 counts them while it happens",
+       own_mb is not None and own_mb >= heavy - 1, f"register 1064 = {own_mb}, {heavy} heavy cycles")
 warn = re.search(r"overrun\(s\) \(total \d+, \d+ periods skipped, (\d+) with the program alone", out)
 report("the overrun warning says how many were the program's", warn is not None and int(warn.group(1)) >= 1,
        "no such warning in the log" if warn is None else warn.group(0))
