@@ -3,7 +3,11 @@
 Report: PASS/FAIL lines in mk/suite.sh's format under a suite prefix.
 wait_for: poll a condition until it holds or a timeout passes.
 Process: a child whose output lines are echoed and kept with their time.
+Plcrt: a plcrt started on a configuration, its output in a log file.
 """
+import os
+import signal
+import socket
 import subprocess
 import threading
 import time
@@ -67,7 +71,52 @@ class Process:
 
 def free_port():
     """A TCP port free on 127.0.0.1 now (for a plcrt's Modbus server)."""
-    import socket
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+class Plcrt:
+    """One plcrt process; its stdout and stderr go to WORK/NAME-N.log."""
+    count = 0
+    running = []
+
+    def __init__(self, exe, cfg, work, name):
+        Plcrt.count += 1
+        Plcrt.running.append(self)
+        self.logpath = os.path.join(work, f"{name}-{Plcrt.count}.log")
+        self.log = open(self.logpath, "w+")
+        self.p = subprocess.Popen([exe, "-c", cfg], stdout=self.log, stderr=self.log)
+        for _ in range(200):
+            if "modbus: listening" in self.output():
+                return
+            if self.p.poll() is not None:
+                raise RuntimeError(f"plcrt exited ({self.p.returncode}): " + self.output()[-500:])
+            time.sleep(0.05)
+        raise RuntimeError("plcrt does not listen: " + self.output()[-500:])
+
+    def output(self):
+        self.log.flush()
+        self.log.seek(0)
+        return self.log.read()
+
+    def alive(self):
+        return self.p.poll() is None
+
+    def stop(self, sig=signal.SIGTERM):
+        if self.p.poll() is not None:
+            return self.p.returncode
+        self.p.send_signal(sig)
+        try:
+            return self.p.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.p.kill()
+            self.p.wait()
+            return -999
+
+    @classmethod
+    def kill_all(cls):
+        for r in cls.running:
+            if r.p.poll() is None:
+                r.p.kill()
+                r.p.wait()

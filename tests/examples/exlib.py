@@ -3,17 +3,14 @@ configuration with a free port and a private retain file, talk to it with
 pymodbus, poll for conditions, report PASS:/FAIL: lines."""
 import os
 import re
-import signal
 import struct
-import subprocess
 import sys
-import time
 
 from pymodbus.client import ModbusTcpClient
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 import peer  # noqa: E402
-from peer import free_port  # noqa: E402,F401
+from peer import Plcrt, free_port  # noqa: E402,F401
 
 MD = 2048            # holding register of %MD0; %MDn at MD + 2n
 DIAG = 1024          # plcrt's diagnostics (input registers)
@@ -61,52 +58,6 @@ def ini_section(path, name):
             k, v = line.split("=", 1)
             keys[k.strip()] = v.strip()
     return keys
-
-
-class Plcrt:
-    """One plcrt process; its stdout and stderr go to WORK/NAME-N.log."""
-    count = 0
-    running = []
-
-    def __init__(self, exe, cfg, work, name):
-        Plcrt.count += 1
-        Plcrt.running.append(self)
-        self.logpath = os.path.join(work, f"{name}-{Plcrt.count}.log")
-        self.log = open(self.logpath, "w+")
-        self.p = subprocess.Popen([exe, "-c", cfg], stdout=self.log, stderr=self.log)
-        for _ in range(200):
-            if "modbus: listening" in self.output():
-                return
-            if self.p.poll() is not None:
-                raise RuntimeError(f"plcrt exited ({self.p.returncode}): " + self.output()[-500:])
-            time.sleep(0.05)
-        raise RuntimeError("plcrt does not listen: " + self.output()[-500:])
-
-    def output(self):
-        self.log.flush()
-        self.log.seek(0)
-        return self.log.read()
-
-    def alive(self):
-        return self.p.poll() is None
-
-    def stop(self, sig=signal.SIGTERM):
-        if self.p.poll() is not None:
-            return self.p.returncode
-        self.p.send_signal(sig)
-        try:
-            return self.p.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            self.p.kill()
-            self.p.wait()
-            return -999
-
-    @classmethod
-    def kill_all(cls):
-        for r in cls.running:
-            if r.p.poll() is None:
-                r.p.kill()
-                r.p.wait()
 
 
 def s32(hi, lo):

@@ -7,13 +7,11 @@ the cycles are back on time once the program is light again.
 usage: test_overrun.py PLCRT WORKDIR"""
 import os
 import re
-import signal
-import subprocess
 import sys
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Report, free_port, wait_for  # noqa: E402
+from peer import Plcrt, Report, free_port, wait_for  # noqa: E402
 from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 PLCRT, WORK = sys.argv[1], sys.argv[2]
@@ -24,8 +22,7 @@ cfg = os.path.join(WORK, "spin.ini")
 with open(cfg, "w") as f:
     f.write(f"[io]\nbackend = none\n[modbus]\nbind = 127.0.0.1\nport = {port}\n")
 
-log = open(os.path.join(WORK, "spin.log"), "w+")
-plc = subprocess.Popen([PLCRT, "-c", cfg], stdout=log, stderr=log)
+plc = Plcrt(PLCRT, cfg, WORK, "spin")       # returns once Modbus listens
 mb = ModbusTcpClient("127.0.0.1", port=port, timeout=3)
 
 
@@ -58,11 +55,9 @@ try:
     # light again: 0.5 s at 2 ms is 250 cycles; allow a loaded machine half
     report("light again, the cycles are back on time", c3 - c2 >= 125, f"{c3 - c2} cycles in 0.5 s")
 finally:
-    plc.send_signal(signal.SIGTERM)
-    rc = plc.wait(10)
+    rc = plc.stop()
     mb.close()
-log.seek(0)
-out = log.read()
+out = plc.output()
 m = re.search(r"(\d+) overruns \(", out)
 e = re.search(r"overruns: (\d+) with the program's execution alone over the period, (\d+) after a late wake-up", out)
 heavy = (c1 - c0) if c1 is not None and c0 is not None else 0

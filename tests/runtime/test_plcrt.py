@@ -19,7 +19,7 @@ import time
 from pymodbus.client import ModbusTcpClient
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import free_port  # noqa: E402
+from peer import Plcrt, free_port  # noqa: E402
 
 PLCRT, RANDOM_CLIENT, WORK = sys.argv[1], sys.argv[2], sys.argv[4]
 PORT = free_port() if sys.argv[3] == "auto" else int(sys.argv[3])
@@ -57,35 +57,9 @@ period = 1
     return path
 
 
-RUNNING = []
-
-
-class Plcrt:
-    def __init__(self, cfg):
-        RUNNING.append(self)
-        self.n = len(RUNNING)
-        self.log = open(os.path.join(WORK, f"plcrt-{self.n}.log"), "w+")
-        self.p = subprocess.Popen([PLCRT, "-c", cfg], stdout=self.log, stderr=self.log)
-        for _ in range(200):
-            if "modbus: listening" in self.output():
-                return
-            if self.p.poll() is not None:
-                raise RuntimeError("plcrt exited: " + self.output())
-            time.sleep(0.05)
-        raise RuntimeError("plcrt does not listen")
-
-    def output(self):
-        self.log.flush()
-        self.log.seek(0)
-        return self.log.read()
-
-    def stop(self, sig=signal.SIGTERM):
-        self.p.send_signal(sig)
-        try:
-            return self.p.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            self.p.kill()
-            return -999
+def start(cfg):
+    """plcrt on cfg, listening; its output in WORK/plcrt-N.log."""
+    return Plcrt(PLCRT, cfg, WORK, "plcrt")
 
 
 def client():
@@ -286,7 +260,7 @@ def test_sigusr1(p):
 
 
 def test_sigterm_retain():
-    p = Plcrt(ini())
+    p = start(ini())
     last, stop = [None], [False]
 
     def writer():
@@ -311,7 +285,7 @@ def test_sigterm_retain():
     t.join()
     out = p.output()
     report("SIGTERM: exit status 0, statistics printed", rc == 0 and "statistics" in out, f"rc {rc}")
-    p = Plcrt(ini())
+    p = start(ini())
     c = client()
     got = s32(c.read_holding_registers(9000, 2, slave=1).registers)
     report("SIGTERM while a client writes: the retained value is the last acknowledged one",
@@ -325,7 +299,7 @@ def test_sigterm_retain():
         time.sleep(0.1)
     c.close()
     p.stop(signal.SIGKILL)
-    p = Plcrt(ini())
+    p = start(ini())
     c = client()
     got = s32(c.read_holding_registers(9000, 2, slave=1).registers)
     report("kill -9 after a periodic save: the value is retained", got == 777, f"retained {got}")
@@ -339,7 +313,7 @@ def main():
         if f.startswith("plc.retain") or f.endswith(".log"):
             os.unlink(os.path.join(WORK, f))
     test_cli()
-    p = Plcrt(ini())
+    p = start(ini())
     try:
         c = client()
         over0, own0 = diag(c, 2), diag(c, 40)
@@ -367,10 +341,7 @@ def main():
         test_sigterm_retain()
     except Exception as e:  # noqa: BLE001
         report("sigterm/retain run", False, repr(e))
-    for r in RUNNING:                     # whatever a failed test left running
-        if r.p.poll() is None:
-            r.p.kill()
-            r.p.wait()
+    Plcrt.kill_all()                      # whatever a failed test left running
     sys.exit(1 if failed else 0)
 
 
