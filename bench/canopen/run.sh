@@ -1,5 +1,6 @@
 #!/bin/sh
-# make bench: the CANopen figures, measured on vcan0 inside User-Mode Linux.
+# make bench: the CANopen figures, measured on vcan0 inside a kernel with CAN
+# (tests/canopen/bus_run.sh: User-Mode Linux, or QEMU where UML cannot run).
 b=$1
 "$b/co_core_bench"
-exec tests/canopen/uml_run.sh "$b/bench_uml" sh bench/canopen/bench_bus.sh "$b" 3
+BUS_BUILD=$(cd "$b" && pwd) exec tests/canopen/bus_run.sh "$b/bench_uml" sh bench/canopen/bench_bus.sh "$b" 3

@@ -37,10 +37,38 @@ $(CO_BUILD)/co_testmaster: tests/canopen/co_testmaster.c $(CO_LIB) $(CO_HDR)
 	$(CC) $(CFLAGS) -I$(CO_DIR) $< $(CO_LIB) -o $@
 ALL += $(CO_BUILD)/co_testmaster
 
-# real-bus tests: User-Mode Linux with vcan0, python-canopen slaves
-.PHONY: canopen_bus
-canopen_bus: $(CO_BUILD)/co_testmaster
-	@mk/suite.sh $(RESULTS) canopen_bus tests/canopen/run_bus.sh $(CO_BUILD)
+# real-bus tests: a kernel with CAN (User-Mode Linux, or QEMU where UML
+# cannot run) with vcan0 and python-canopen slaves. The backend is chosen
+# once per `make test` (tests/canopen/bus_backend.sh; CAN_BUS_BACKEND forces
+# one) and every bus suite uses it. UML runs with the xstate shim preloaded,
+# which lets it boot on hosts with a large XSAVE area (AMX).
+$(CO_BUILD)/xstate_shim.so: tests/canopen/xstate_shim.c
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -shared -fPIC $< -o $@ -ldl
+$(CO_BUILD)/xstate_guest: tests/canopen/xstate_guest.c
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) $< -o $@
+$(CO_BUILD)/check_xstate: tests/canopen/check_xstate.c tests/canopen/xstate_shim.c
+	$(CC) $(CFLAGS) $^ -o $@ -ldl $$(pkg-config --cflags --libs check)
+$(CO_BUILD)/check_xstate_san: tests/canopen/check_xstate.c tests/canopen/xstate_shim.c
+	$(CC) $(CFLAGS) $(SAN) $^ -o $@ -ldl $$(pkg-config --cflags --libs check)
+ALL += $(CO_BUILD)/xstate_shim.so $(CO_BUILD)/xstate_guest $(CO_BUILD)/check_xstate \
+       $(CO_BUILD)/check_xstate_san
+
+.PHONY: xstate_shim xstate_shim_san bus-backend canopen_bus
+xstate_shim: $(CO_BUILD)/check_xstate
+	@mk/suite.sh $(RESULTS) xstate_shim $<
+xstate_shim_san: $(CO_BUILD)/check_xstate_san
+	@mk/suite.sh $(RESULTS) xstate_shim_san $<
+TESTS += xstate_shim xstate_shim_san
+
+BUS_CHOICE := $(RESULTS)/bus-backend
+BUS_RUN    := env BUS_CHOICE_FILE=$(BUS_CHOICE) BUS_BUILD=$(abspath $(CO_BUILD)) tests/canopen/bus_run.sh
+bus-backend: $(CO_BUILD)/xstate_shim.so $(CO_BUILD)/xstate_guest
+	@[ -s $(BUS_CHOICE) ] || tests/canopen/bus_backend.sh $(BUS_CHOICE) $(CO_BUILD)
+
+canopen_bus: $(CO_BUILD)/co_testmaster | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_bus env BUS_RUN="$(BUS_RUN)" tests/canopen/run_bus.sh $(CO_BUILD)
 TESTS += canopen_bus
 
 # the plcrt backend `canopen` (built once the runtime's interface is there);

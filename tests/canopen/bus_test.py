@@ -1,7 +1,12 @@
-"""Real-bus tests of the CANopen master, run inside User-Mode Linux on vcan0
-(tests/canopen/uml_run.sh): the stand-alone master (co_testmaster, program
+"""Real-bus tests of the CANopen master, run on vcan0 inside a kernel with
+CAN (tests/canopen/bus_run.sh: User-Mode Linux, or QEMU where UML cannot run): the stand-alone master (co_testmaster, program
 "echo") against two python-canopen CiA 401 slaves, plus a node id nobody
 answers. Prints PASS/FAIL lines. The candump trace is kept on failure.
+
+Time limits that the protocol sets (a heartbeat lost within two consumer
+periods) are checked with the slaves' measured round trip added: that is
+how late this script, which can run 15 times slower under QEMU's emulation,
+sees what happened on the bus. Under User-Mode Linux it is a few ms.
 
     $PY tests/canopen/bus_test.py BUILD_DIR OUT_DIR
 """
@@ -45,8 +50,8 @@ HB_CONS = 0.250
 m = Master(["-i", "vcan0", "-n", "2,3,9", "-c", "10000", "-H", "100:250"])
 
 # 2. start-up: nodes 2 and 3 configured and started, node 9 reported
-ok = m.wait("start-up done", 8) is not None
-ok = ok and wait_for(lambda: s2.state == 5 and s3.state == 5, 1)
+ok = m.wait("start-up done", 20) is not None
+ok = ok and wait_for(lambda: s2.state == 5 and s3.state == 5, 5)
 report("startup", ok,
        f"states {s2.state} {s3.state}")
 report("silent_node_reported",
@@ -62,37 +67,53 @@ want = {(0x1400, 1): 0x202, (0x1401, 1): 0x302, (0x1402, 1): 0x80000402,
 bad = [f"0x{i:04X}:{s} = 0x{s2.get(i, s):X}" for (i, s), v in want.items() if s2.get(i, s) != v]
 report("sdo_configuration", not bad, ", ".join(bad))
 
-# 4. digital and analog round trips through the master's program
+# 0. with User-Mode Linux, vector registers survive context switches (the
+#    FP state goes through ptrace, widened by the xstate shim on AMX hosts)
+if os.environ.get("BUS_BACKEND") == "uml":
+    r = subprocess.run([os.path.join(build, "xstate_guest"), "4", "2000"],
+                       capture_output=True, text=True, timeout=120)
+    print(r.stdout, end="", flush=True)
+    if r.returncode != 0 and "FAIL:" not in r.stdout:
+        report("xstate/vector_registers_kept", False, f"status {r.returncode}: {r.stderr.strip()}")
+
+# 4. digital and analog round trips through the master's program; the
+#    slowest is this run's round trip, the allowance for the timed checks
+rts = []
 for s, d, a in ((s2, 0xA5, -12345), (s3, 0x3C, 32767)):
     s.set(0x6000, 1, d)
     s.set(0x6000, 8, 0x81)
     s.set(0x6401, 2, a)
     t0 = time.monotonic()
     ok = wait_for(lambda: s.get(0x6200, 1) == d and s.get(0x6200, 8) == 0x81
-                  and s.get(0x6411, 2) == a, 1.0)
+                  and s.get(0x6411, 2) == a, 10.0)
+    rts.append(time.monotonic() - t0)
     report(f"roundtrip_node{s.id}", ok,
-           f"{(time.monotonic() - t0) * 1000:.1f} ms; out {s.get(0x6200, 1):#x} {s.get(0x6411, 2)}")
+           f"{rts[-1] * 1000:.1f} ms; out {s.get(0x6200, 1):#x} {s.get(0x6411, 2)}")
+rt = max(rts)
+patience = max(1.0, 10 * rt)   # for waits that check a value, not a time
 
 # 5. node 3's heartbeat stops: its outputs safe and its fault flagged
 #    within two consumer periods; node 2 keeps exchanging
 t_stop = time.monotonic()
 s3.stop_heartbeat()
-t_lost = m.wait("node 3: heartbeat lost", 2 * HB_CONS + 0.5, since=t_stop)
-ok = wait_for(lambda: s3.get(0x6200, 1) == 0 and s3.get(0x6411, 2) == 0, 2 * HB_CONS)
+limit = 2 * HB_CONS + rt
+t_lost = m.wait("node 3: heartbeat lost", limit + patience, since=t_stop)
+ok = wait_for(lambda: s3.get(0x6200, 1) == 0 and s3.get(0x6411, 2) == 0, limit + patience)
 t_safe = time.monotonic()
-report("hb_lost_detected", t_lost is not None and t_lost - t_stop <= 2 * HB_CONS,
-       f"{(t_lost - t_stop) * 1000:.0f} ms after the stop" if t_lost else "not detected")
-report("hb_lost_outputs_safe", ok and t_safe - t_stop <= 2 * HB_CONS,
-       f"{(t_safe - t_stop) * 1000:.0f} ms after the stop")
+report("hb_lost_detected", t_lost is not None and t_lost - t_stop <= limit,
+       (f"{(t_lost - t_stop) * 1000:.0f} ms after the stop" if t_lost else "not detected")
+       + f", limit {limit * 1000:.0f} ms")
+report("hb_lost_outputs_safe", ok and t_safe - t_stop <= limit,
+       f"{(t_safe - t_stop) * 1000:.0f} ms after the stop, limit {limit * 1000:.0f} ms")
 s2.set(0x6000, 1, 0x42)
-report("other_node_keeps_exchanging", wait_for(lambda: s2.get(0x6200, 1) == 0x42, 0.5))
+report("other_node_keeps_exchanging", wait_for(lambda: s2.get(0x6200, 1) == 0x42, patience))
 
 # 6. node 3 resets (power cycle): reconfigured, started, exchanging again
 t_reset = time.monotonic()
 s3.boot()
-ok = m.wait("node 3: configured", 3, since=t_reset) is not None
+ok = m.wait("node 3: configured", 3 + patience, since=t_reset) is not None
 s3.set(0x6000, 1, 0x77)
-ok = ok and wait_for(lambda: s3.state == 5 and s3.get(0x6200, 1) == 0x77, 1.0)
+ok = ok and wait_for(lambda: s3.state == 5 and s3.get(0x6200, 1) == 0x77, patience)
 report("reset_node_reconfigured", ok and s3.get(0x1601, 1) == 0x64110110 and s3.get(0x1017) == 100,
        f"state {s3.state}, 0x1601:01 0x{s3.get(0x1601, 1):X}")
 report("unexpected_bootup_logged", m.seen("node 3: unexpected boot-up", t_reset) is not None)
@@ -100,7 +121,7 @@ report("unexpected_bootup_logged", m.seen("node 3: unexpected boot-up", t_reset)
 # 7. EMCY from node 2
 t_e = time.monotonic()
 s2.node.emcy.send(0x3210, 0x05, b"\x01\x02\x03\x04\x05")
-report("emcy_logged", m.wait("node 2: EMCY 0x3210 (voltage), error register 0x05", 1, t_e) is not None)
+report("emcy_logged", m.wait("node 2: EMCY 0x3210 (voltage), error register 0x05", patience, t_e) is not None)
 
 m.stop()
 summary = {l.split(":")[0]: l for _, l in m.lines if l.startswith("node ")}

@@ -1,10 +1,11 @@
 # plcrt as the CANopen master (included from plc_runtime/part.mk once the
-# runtime is there): the real-bus tests of plcrt inside User-Mode Linux.
+# runtime is there): the real-bus tests of plcrt inside a kernel with CAN
+# (tests/canopen/bus_run.sh).
 $(eval $(call plcrt_program,canopen_io,tests/canopen/st/canopen_io.st))
 
 .PHONY: canopen_plcrt
-canopen_plcrt: $(BUILD)/plc/canopen_io/plcrt
-	@mk/suite.sh $(RESULTS) canopen_plcrt tests/canopen/uml_run.sh $(CO_BUILD)/uml_plcrt \
+canopen_plcrt: $(BUILD)/plc/canopen_io/plcrt | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_plcrt $(BUS_RUN) $(CO_BUILD)/uml_plcrt \
 	  @PY@ tests/canopen/plcrt_bus_test.py $(BUILD)/plc/canopen_io/plcrt $(CO_BUILD)/uml_plcrt
 TESTS += canopen_plcrt
 
@@ -12,8 +13,8 @@ TESTS += canopen_plcrt
 ifneq ($(ST_LIB),)
 $(eval $(call plcrt_program,canopen_axis,$(ST_LIB) tests/canopen/st/canopen_axis.st))
 .PHONY: canopen_axis
-canopen_axis: $(BUILD)/plc/canopen_axis/plcrt
-	@mk/suite.sh $(RESULTS) canopen_axis tests/canopen/uml_run.sh $(CO_BUILD)/uml_axis \
+canopen_axis: $(BUILD)/plc/canopen_axis/plcrt | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_axis $(BUS_RUN) $(CO_BUILD)/uml_axis \
 	  @PY@ tests/canopen/plcrt_axis_test.py $(BUILD)/plc/canopen_axis/plcrt $(CO_BUILD)/uml_axis
 TESTS += canopen_axis
 endif
