@@ -1,5 +1,5 @@
-"""Real-bus tests of plcrt as the CANopen master, inside User-Mode Linux on
-vcan0 (tests/canopen/uml_run.sh): the PLC program st/canopen_io.st against
+"""Real-bus tests of plcrt as the CANopen master, on vcan0 inside a kernel
+with CAN (tests/canopen/bus_run.sh): the PLC program st/canopen_io.st against
 two python-canopen CiA 401 slaves (nodes 2 and 3). Checks what a user sees:
 the slaves' outputs, their dictionaries, plcrt's log, the Modbus registers.
 Prints PASS/FAIL lines; the candump trace is kept on failure.
@@ -71,8 +71,8 @@ report("no_such_interface", r.returncode == 2 and "CAN interface vcan9: no such 
 net = connect("vcan0")
 s2, s3 = Slave401(net, 2), Slave401(net, 3)
 plc = Plcrt(ini(os.path.join(out, "plcrt.ini")))
-ok = plc.wait("2 of 2 nodes operational", 10) is not None
-ok = ok and wait_for(lambda: s2.state == 5 and s3.state == 5, 1)
+ok = plc.wait("2 of 2 nodes operational", 20) is not None
+ok = ok and wait_for(lambda: s2.state == 5 and s3.state == 5, 5)
 report("startup", ok, f"states {s2.state} {s3.state}")
 mb = ModbusTcpClient("127.0.0.1", port=PORT)
 wait_for(lambda: mb.connect(), 5)
@@ -89,57 +89,68 @@ want = {(0x1400, 1): 0x203, (0x1401, 1): 0x303, (0x1800, 1): 0x183, (0x1801, 1):
 bad = [f"0x{i:04X}:{s} = 0x{s3.get(i, s):X}" for (i, s), v in want.items() if s3.get(i, s) != v]
 report("sdo_configuration", not bad, ", ".join(bad))
 
-# I/O round trips through the PLC program (expected values by hand)
+# I/O round trips through the PLC program (expected values by hand); the
+# slowest is this run's round trip: how late this script sees the bus (a
+# few ms under User-Mode Linux, far more under QEMU's emulation), added to
+# the time limits the protocol sets
+rts = []
 for s, di, ai, do, ao in ((s2, 0xA0, -1000, 0xAF, -500), (s3, 0x55, 32767, 0x5A, 16383)):
     s.set(0x6000, 1, di)
     s.set(0x6401, 1, ai)
     t0 = time.monotonic()
-    ok = wait_for(lambda: s.get(0x6200, 1) == do and s.get(0x6411, 1) == ao, 1.0)
-    report(f"roundtrip_node{s.id}", ok, f"{(time.monotonic() - t0) * 1000:.0f} ms; "
+    ok = wait_for(lambda: s.get(0x6200, 1) == do and s.get(0x6411, 1) == ao, 10.0)
+    rts.append(time.monotonic() - t0)
+    report(f"roundtrip_node{s.id}", ok, f"{rts[-1] * 1000:.0f} ms; "
            f"out 0x{s.get(0x6200, 1):02X} {s.get(0x6411, 1)}")
+rt = max(rts)
+patience = max(1.0, 10 * rt)   # for waits that check a value, not a time
 report("modbus_sees_inputs", ireg(0, 2) == [(-1000) & 0xFFFF, 32767], str(ireg(0, 2)))
 
 # node 3's heartbeat stops: outputs safe, fault flagged within two consumer
 # periods (image, Modbus, log); node 2 keeps exchanging
+limit = 2 * HB_CONS + rt
 t_stop = time.monotonic()
 s3.stop_heartbeat()
-ok = wait_for(lambda: s3.get(0x6200, 1) == 0 and s3.get(0x6411, 1) == 0, 2 * HB_CONS)
+ok = wait_for(lambda: s3.get(0x6200, 1) == 0 and s3.get(0x6411, 1) == 0, limit + patience)
 t_safe = time.monotonic()
-report("hb_lost_outputs_safe", ok, f"{(t_safe - t_stop) * 1000:.0f} ms after the stop")
-ok = wait_for(lambda: (ireg(21) or [0])[0] & 1 == 1, 2 * HB_CONS - (t_safe - t_stop))
-report("hb_lost_fault_flag", ok, f"status word {ireg(21)}, {(time.monotonic() - t_stop) * 1000:.0f} ms")
+report("hb_lost_outputs_safe", ok and t_safe - t_stop <= limit,
+       f"{(t_safe - t_stop) * 1000:.0f} ms after the stop, limit {limit * 1000:.0f} ms")
+ok = wait_for(lambda: (ireg(21) or [0])[0] & 1 == 1, limit + patience)
+t_flag = time.monotonic()
+report("hb_lost_fault_flag", ok and t_flag - t_stop <= limit,
+       f"status word {ireg(21)}, {(t_flag - t_stop) * 1000:.0f} ms, limit {limit * 1000:.0f} ms")
 hr = mb.read_holding_registers(10, 1, slave=1)
 report("hb_lost_seen_by_program", not hr.isError() and hr.registers[0] & 1 == 1,
        "fault bits copied by the program to %QW10")
-report("hb_lost_logged", plc.wait("node 3: heartbeat lost", 1, t_stop) is not None)
+report("hb_lost_logged", plc.wait("node 3: heartbeat lost", patience, t_stop) is not None)
 s2.set(0x6000, 1, 0x10)
-report("other_node_keeps_exchanging", wait_for(lambda: s2.get(0x6200, 1) == 0x1F, 0.5))
+report("other_node_keeps_exchanging", wait_for(lambda: s2.get(0x6200, 1) == 0x1F, patience))
 
 # node 3 resets: reconfigured, restarted, counted
 t_reset = time.monotonic()
 s3.boot()
 s3.set(0x6000, 1, 0x00)
-ok = wait_for(lambda: s3.state == 5 and s3.get(0x6200, 1) == 0x0F, 3)
+ok = wait_for(lambda: s3.state == 5 and s3.get(0x6200, 1) == 0x0F, 3 + patience)
 report("reset_node_reconfigured", ok and s3.get(0x1601, 1) == 0x64110110,
        f"state {s3.state}, out 0x{s3.get(0x6200, 1):02X}")
 d = ireg(DIAG, 16) or [0] * 16
 report("diag_registers", d[2] == 2 and d[3] == 2 and d[10] == (3 | 4 << 8) and d[12] == 1 and d[13] == 1,
        f"bus/nodes {d[:4]}, node 3 {d[10:16]}")
-report("status_word_clear", wait_for(lambda: (ireg(21) or [1])[0] & 1 == 0, 1), str(ireg(21)))
+report("status_word_clear", wait_for(lambda: (ireg(21) or [1])[0] & 1 == 0, patience), str(ireg(21)))
 
 # EMCY from node 2: log and registers (count, code)
 t_e = time.monotonic()
 s2.node.emcy.send(0x3210, 0x05, b"\x01\x02\x03\x04\x05")
-ok = plc.wait("node 2: EMCY 0x3210 (voltage), error register 0x05", 1, t_e) is not None
+ok = plc.wait("node 2: EMCY 0x3210 (voltage), error register 0x05", patience, t_e) is not None
 d = ireg(DIAG, 10) or [0] * 10
 report("emcy", ok and d[8] == 1 and d[9] == 0x3210, f"node 2 registers {d[4:10]}")
 
 # shutdown: outputs to their safe state, exit 0
 s2.set(0x6000, 1, 0xF0)
-wait_for(lambda: s2.get(0x6200, 1) == 0xFF, 0.5)
+wait_for(lambda: s2.get(0x6200, 1) == 0xFF, patience)
 plc.p.send_signal(signal.SIGTERM)
 code = plc.p.wait(10)
-ok = wait_for(lambda: s2.get(0x6200, 1) == 0 and s2.get(0x6411, 1) == 0, 0.5)
+ok = wait_for(lambda: s2.get(0x6200, 1) == 0 and s2.get(0x6411, 1) == 0, patience)
 report("shutdown_outputs_safe", code == 0 and ok, f"exit {code}, out 0x{s2.get(0x6200, 1):02X}")
 
 mb.close()

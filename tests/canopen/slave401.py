@@ -227,16 +227,35 @@ def connect(channel="vcan0"):
 
 
 class CanDump:
-    """candump -L of the bus into path while the test runs; the trace is
-    kept only when a test failed (close(keep))."""
+    """candump -L of the bus into path while the test runs; stop() ends the
+    recording, frames(cob_id) reads it back with the kernel's timestamps,
+    and the trace is kept only when a test failed (close(keep))."""
 
     def __init__(self, path, channel="vcan0"):
         self.path = path
         self.p = subprocess.Popen(["candump", "-L", channel], stdout=open(path, "w"))
 
+    def stop(self):
+        if self.p.poll() is None:
+            self.p.terminate()
+            self.p.wait()
+
+    def frames(self, cob_id):
+        """[(time, data bytes)] of every frame with this COB-ID, in order."""
+        self.stop()
+        out = []
+        with open(self.path) as f:
+            for line in f:
+                parts = line.split()
+                if len(parts) != 3 or "#" not in parts[2]:
+                    continue
+                ident, data = parts[2].split("#", 1)
+                if int(ident, 16) == cob_id:
+                    out.append((float(parts[0].strip("()")), bytes.fromhex(data)))
+        return out
+
     def close(self, keep):
-        self.p.terminate()
-        self.p.wait()
+        self.stop()
         if keep:
             print(f"candump trace kept: {self.path}")
         else:
