@@ -8,6 +8,9 @@
 ** and handed over as a short line of the same shape whose section, key or
 ** value is a placeholder; the handler puts the real text back. Placeholders
 ** are control characters, which a configuration file may not contain.
+** Lines are handed over without their indent: an indented line is a line
+** like any other, never the continuation of the value above (libinih's
+** multi-line values).
 */
 #include <arpa/inet.h>
 #include <ctype.h>
@@ -47,7 +50,6 @@ typedef struct parse {
     char long_section[CFG_MAX_LINE + 1];
     char long_key[CFG_MAX_LINE + 1];
     char long_value[CFG_MAX_LINE + 1];
-    char long_whole[CFG_MAX_LINE + 1];  /* as a continuation line */
     char section[64];                   /* the last [section] read, for messages */
 } parse;
 
@@ -334,7 +336,6 @@ static int handler(void *user, const char *s, const char *key, const char *v)
     if (!strcmp(s, PH_NAME)) s = p->long_section;
     if (!strcmp(key, PH_NAME)) key = p->long_key;
     if (!strcmp(v, PH_VALUE)) v = p->long_value;
-    else if (strpbrk(v, PH_NAME PH_VALUE)) v = p->long_whole;   /* a continuation line */
 
     if (!strcmp(s, "modbus.symbols")) return p->pass == 1 ? 1 : symbol(p, s, key, v);
     if (is_own_section(s)) return own_key(p, s, key, v);
@@ -382,12 +383,7 @@ static void long_line(parse *p, const char *text, size_t len, char *buf)
     char ln[CFG_MAX_LINE + 1];
     memcpy(ln, text, len);
     ln[len] = 0;
-    const char *indent = isspace((unsigned char)ln[0]) ? " " : "";
-    char *start = lskip(rstrip(ln));
-    /* as a continuation of the previous key (libinih decides) */
-    snprintf(p->long_whole, sizeof p->long_whole, "%s", start);
-    *find_or_comment(p->long_whole, NULL) = 0;
-    rstrip(p->long_whole);
+    char *start = rstrip(ln);
     if (*start == ';' || *start == '#') {
         strcpy(buf, ";\n");
     } else if (*start == '[') {
@@ -395,9 +391,9 @@ static void long_line(parse *p, const char *text, size_t len, char *buf)
         if (*end == ']') {
             *end = 0;
             snprintf(p->long_section, sizeof p->long_section, "%s", start + 1);
-            sprintf(buf, "%s[" PH_NAME "]\n", indent);
+            strcpy(buf, "[" PH_NAME "]\n");
         } else {
-            sprintf(buf, "%s[\n", indent);                /* libinih: syntax error */
+            strcpy(buf, "[\n");                            /* libinih: syntax error */
         }
     } else {
         char *end = find_or_comment(start, "=:");
@@ -407,9 +403,9 @@ static void long_line(parse *p, const char *text, size_t len, char *buf)
             char *v = end + 1;
             *find_or_comment(v, NULL) = 0;
             snprintf(p->long_value, sizeof p->long_value, "%s", rstrip(lskip(v)));
-            sprintf(buf, "%s" PH_NAME "=" PH_VALUE "\n", indent);
+            strcpy(buf, PH_NAME "=" PH_VALUE "\n");
         } else {
-            sprintf(buf, "%s" PH_NAME "\n", indent);      /* libinih: syntax error */
+            strcpy(buf, PH_NAME "\n");                     /* libinih: syntax error */
         }
     }
 }
@@ -441,12 +437,6 @@ static char *reader(char *buf, int n, void *stream)
     p->line++;
     size_t len = (size_t)(e - s);
     if (len && s[len - 1] == '\r') len--;
-    const char *t = s;
-    while (t < s + len && isspace((unsigned char)*t)) t++;
-    if (*t == '[') {                                 /* section, for messages */
-        size_t k = strcspn(t + 1, "]\n");
-        snprintf(p->section, sizeof p->section, "%.*s", (int)(k < sizeof p->section ? k : sizeof p->section - 1), t + 1);
-    }
     char key[80];
     for (size_t i = 0; i < len; i++)
         if ((unsigned char)s[i] < 0x20 && s[i] != '\t') {
@@ -462,6 +452,14 @@ static char *reader(char *buf, int n, void *stream)
                 len, CFG_MAX_LINE);
         strcpy(buf, ";\n");
         return buf;
+    }
+    size_t lead = strspn(s, " \t");                  /* no indent: see the top */
+    if (lead > len) lead = len;
+    s += lead;
+    len -= lead;
+    if (*s == '[') {                                 /* section, for messages */
+        size_t k = strcspn(s + 1, "]\n");
+        snprintf(p->section, sizeof p->section, "%.*s", (int)(k < sizeof p->section ? k : sizeof p->section - 1), s + 1);
     }
     if (len + 2 <= (size_t)n) {
         memcpy(buf, s, len);

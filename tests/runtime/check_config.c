@@ -343,6 +343,13 @@ START_TEST(whole)
     bad("[modbus]\nport = x\n[io]\nbackend = profibus\n", "plant.ini:2: [modbus] port");
     bad("[io]\nbackend = profibus\n[modbus]\nport = x\n", "plant.ini:2: [io] backend");
     bad("[modbus]\nport = x\nbad line\n", "plant.ini:2: [modbus] port");
+    /* an indent is not a continuation of the value above (libinih's
+    ** multi-line values): a line like any other */
+    ck_assert_msg(load("[modbus]\n  port = 1600\n\tbind = localhost\n") == 0, "%s", err);
+    ck_assert_int_eq(c.mb_port, 1600);
+    ck_assert_str_eq(c.mb_bind, "127.0.0.1");
+    config_free(&c);
+    bad("[plc]\nstatus_vars = A.B,\n    C.D\n", "plant.ini:3: syntax error");
     /* a byte order mark is not part of the first line */
     ck_assert_msg(load("\xEF\xBB\xBF[modbus]\nport = 1600\n") == 0, "%s", err);
     ck_assert_int_eq(c.mb_port, 1600);
@@ -355,14 +362,22 @@ END_TEST
 START_TEST(robust)
 {
     static const char good[] =
-        "[plc]\nlog_level = debug\nstatus_interval = 2\nstatus_vars = A.B, C.D\n"
+        "[plc]\nlog_level = debug\nstatus_interval = 2\n"
         "[scan]\npriority = 0\ncpu = 1\nlock_memory = no\n"
         "[io]\nbackend = sim\n[sim.axis0]\ndac = %QW4\nmaxvel = 5e4\n"
-        "[modbus.symbols]\nCONFIG0.X = holding 9000 rw\n[retain]\nperiod = 0\n";
+        "[modbus.symbols]\nCONFIG0.X = holding 9000 rw\n[retain]\nperiod = 0\n"
+        "[plc]\nstatus_vars = CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.ONE, CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.TWO, "
+        "CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.THREE, CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.FOUR ; and a comment\n"
+        "  [modbus.symbols] ; a long section line, indented ...........................................\n"
+        "CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.ONE.AT.THE.HOLDING.REGISTERS.OF.THE.MAP.AND.MORE.TEXT = holding 300\n";
     static const char bytes[] = "[]=;:# \t\n\r,.%0123456789aAzZ\001\377";
-    char t[600];
+    char t[1200];
     unsigned seed = 12345;
     int accepted = 0, refused = 0;
+    ck_assert_msg(load(good) == 0, "%s", err);
+    ck_assert_int_eq(c.nstatus, 4);
+    ck_assert_int_eq(c.nsymbols, 2);
+    config_free(&c);
     for (int k = 0; k < 3000; k++) {
         strcpy(t, good);
         size_t len = strlen(t);
