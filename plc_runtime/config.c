@@ -271,6 +271,9 @@ static int own_key(parse *p, const char *s, const char *key, const char *v)
         return status_vars(p, s, key, v);
     case K_BIND:
         if (bind_addr(v, f, k->size, why, sizeof why)) return fail(p, s, key, "%s", why);
+        c->mb_bind_name[0] = 0;
+        if (!only(v, "0123456789.") && get_str(v, c->mb_bind_name, sizeof c->mb_bind_name))
+            return fail(p, s, key, "host name longer than %zu characters", sizeof c->mb_bind_name - 1);
         return 1;
     case K_BACKEND:
         if (!io_backend_find(v)) {
@@ -627,8 +630,9 @@ static int check_bind(const plc_config *c, char *err, size_t errlen)
         }
         freeifaddrs(ifs);
         if (!local) {
-            config_msg(c, "modbus", "bind", err, errlen, "%s is not an address of this host (its addresses: %s; "
-                       "0.0.0.0 = every interface)", c->mb_bind, list);
+            config_msg(c, "modbus", "bind", err, errlen, "%s%s%s%s is not an address of this host (its addresses: %s; "
+                       "0.0.0.0 = every interface)", c->mb_bind_name, c->mb_bind_name[0] ? " (" : "", c->mb_bind,
+                       c->mb_bind_name[0] ? ")" : "", list);
             return -1;
         }
     }

@@ -52,6 +52,7 @@ typedef struct plc_config {
     /* [modbus] */
     int mb_enabled;
     char mb_bind[64];                   /* dotted IPv4 (host names resolved) */
+    char mb_bind_name[256];             /* as given, if a host name; "" otherwise */
     int mb_port;
     int mb_max_clients;
     int mb_idle_timeout;                /* s, 0 = never */

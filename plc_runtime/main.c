@@ -31,7 +31,7 @@ static void usage(FILE *f)
         "usage: plcrt [-c FILE.ini] [--check-config] [--help] [--version]\n"
         "Runs the linked PLC program (configuration %s) every %.3f ms.\n"
         "  -c, --config FILE   configuration file (docs/config.md); defaults otherwise\n"
-        "      --check-config  read the configuration, check it against the program, exit\n"
+        "      --check-config  check the configuration (file, program, this host) and exit\n"
         "  -h, --help          this text\n"
         "  -V, --version       version and linked program\n"
         "Signals: SIGINT/SIGTERM stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",

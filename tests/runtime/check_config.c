@@ -168,9 +168,11 @@ START_TEST(bind_names)
 {
     ck_assert_msg(load("[modbus]\nbind = localhost\n") == 0, "%s", err);
     ck_assert_str_eq(c.mb_bind, "127.0.0.1");
+    ck_assert_str_eq(c.mb_bind_name, "localhost");
     config_free(&c);
     ck_assert_msg(load("[modbus]\nbind = 0.0.0.0\n") == 0, "%s", err);
     ck_assert_str_eq(c.mb_bind, "0.0.0.0");
+    ck_assert_str_eq(c.mb_bind_name, "");
     config_free(&c);
     bad("[modbus]\nport = 1502\nbind = ::1\n", "plant.ini:3: [modbus] bind: '::1' is an IPv6 address");
     bad("[modbus]\nbind = fe80::1\n", "plant.ini:2: [modbus] bind: 'fe80::1' is an IPv6 address");
