@@ -359,6 +359,23 @@ START_TEST(whole)
 }
 END_TEST
 
+/* Later checks (program, host) word their messages the same way; a key
+** left at its default is named as such. */
+START_TEST(messages)
+{
+    ck_assert_msg(load("[scan]\n\npriority = 5\n") == 0, "%s", err);
+    char m[300];
+    config_msg(&c, "scan", "priority", m, sizeof m, "refused by %s", "the kernel");
+    ck_assert_str_eq(m, "plant.ini:3: [scan] priority: refused by the kernel");
+    config_msg(&c, "retain", "file", m, sizeof m, "folder %s: gone", ".");
+    ck_assert_str_eq(m, "plant.ini: [retain] file (default): folder .: gone");
+    ck_assert_int_eq(config_line(&c, "scan", "priority"), 3);
+    ck_assert_int_eq(config_line(&c, "scan", "cpu"), 0);
+    ck_assert_int_eq(config_line(&c, "nosuch", "key"), 0);
+    config_free(&c);
+}
+END_TEST
+
 /* Bad files never crash (this suite also runs under ASan/UBSan): a good
 ** file with bytes changed, inserted or dropped at random. */
 START_TEST(robust)
@@ -424,6 +441,7 @@ int main(void)
     tcase_add_test(t, folder);
     tcase_add_test(t, long_lines);
     tcase_add_test(t, whole);
+    tcase_add_test(t, messages);
     tcase_add_test(t, robust);
     suite_add_tcase(s, t);
     return check_run(s);
