@@ -31,7 +31,7 @@ static void usage(FILE *f)
         "usage: plcrt [-c FILE.ini] [--check-config] [--help] [--version]\n"
         "Runs the linked PLC program (configuration %s) every %.3f ms.\n"
         "  -c, --config FILE   configuration file (docs/config.md); defaults otherwise\n"
-        "      --check-config  read the configuration, check it against the program, exit\n"
+        "      --check-config  check the configuration (file, program, this host) and exit\n"
         "  -h, --help          this text\n"
         "  -V, --version       version and linked program\n"
         "Signals: SIGINT/SIGTERM stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",
@@ -111,6 +111,49 @@ static const char *short_path(const char *p)
     return q ? q + 1 : p;
 }
 
+/* The configuration, checked whole: the file (config_load), then against
+** the program (status_vars, the symbol map, even with Modbus disabled),
+** then against this host (config_check_host). The same for --check-config
+** and the start. 0, or the exit status (2) after the message. */
+static int configure(plc_config *cfg, const char *file, const plc_program *prog,
+                     const plc_var *status[CFG_MAX_STATUS], mb_shared **mb)
+{
+    char err[800];
+    if (config_defaults(cfg, err, sizeof err) || (file && config_load(cfg, file, err, sizeof err))) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        return 2;
+    }
+    plc_log_level(cfg->log_level);
+    if (!*prog->ticktime) { fprintf(stderr, "plcrt: the program has no task interval\n"); return 2; }
+
+    /* The program's own initialisation first: located and external
+    ** variables get their addresses there. */
+    prog->init();
+
+    for (int i = 0; i < cfg->nstatus; i++)
+        if (!(status[i] = plc_var_find(prog, cfg->status_vars[i]))) {
+            config_msg(cfg, "plc", "status_vars", err, sizeof err, "no variable %s in the program (see VARIABLES.csv)",
+                       cfg->status_vars[i]);
+            fprintf(stderr, "plcrt: %s\n", err);
+            return 2;
+        }
+    if (!(*mb = mb_new(cfg, prog, err, sizeof err))) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        return 2;
+    }
+    if (!cfg->mb_enabled) {                 /* checked, not served */
+        mb_free(*mb);
+        *mb = NULL;
+    }
+    size_t nretained = 0;
+    for (size_t i = 0; i < prog->nvars; i++) nretained += prog->vars[i].retain != 0;
+    if (config_check_host(cfg, nretained, err, sizeof err)) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        return 2;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     static const struct option opts[] = {
@@ -133,30 +176,12 @@ int main(int argc, char **argv)
     if (optind < argc) { fprintf(stderr, "plcrt: unexpected argument '%s'\n", argv[optind]); usage(stderr); return 2; }
 
     static plc_config cfg;
-    if (config_defaults(&cfg, err, sizeof err) || (file && config_load(&cfg, file, err, sizeof err))) {
-        fprintf(stderr, "plcrt: %s\n", err);
-        return 2;
-    }
-    plc_log_level(cfg.log_level);
     const plc_program *prog = &plc_program_linked;
-    uint64_t period = *prog->ticktime;
-    if (!period) { fprintf(stderr, "plcrt: the program has no task interval\n"); return 2; }
-
-    /* The program's own initialisation first: located and external
-    ** variables get their addresses there. */
-    prog->init();
-
     const plc_var *status[CFG_MAX_STATUS];
-    for (int i = 0; i < cfg.nstatus; i++)
-        if (!(status[i] = plc_var_find(prog, cfg.status_vars[i]))) {
-            fprintf(stderr, "plcrt: %s: [plc] status_vars: no variable %s in the program\n", cfg.file, cfg.status_vars[i]);
-            return 2;
-        }
     mb_shared *mb = NULL;
-    if (cfg.mb_enabled && !(mb = mb_new(&cfg, prog, err, sizeof err))) {
-        fprintf(stderr, "plcrt: %s\n", err);
-        return 2;
-    }
+    int st = configure(&cfg, file, prog, status, &mb);
+    if (st) return st;
+    uint64_t period = *prog->ticktime;
     if (check) {
         printf("%s: configuration OK (backend %s, %d Modbus symbols)\n",
                file ? file : "(defaults)", cfg.backend, cfg.nsymbols);
@@ -201,9 +226,13 @@ int main(int argc, char **argv)
 
     mb_server *srv = NULL;
     if (mb && !(srv = mb_server_start(&cfg, mb, err, sizeof err))) {
-        fprintf(stderr, "plcrt: modbus: %s\n", err);
+        /* found only now: the port taken since the check, for instance */
+        int e = errno;
+        char msg[800];
+        config_msg(&cfg, "modbus", e == EADDRINUSE || e == EACCES ? "port" : "bind", msg, sizeof msg, "%s", err);
+        fprintf(stderr, "plcrt: %s\n", msg);
         cfg.io->close(cfg.io_state);
-        return 1;
+        return 2;
     }
 
     if (cfg.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE))

@@ -1,8 +1,16 @@
 /* Config parsing: a full good file, and each kind of bad file, with the
-** message naming file, line, section and key. */
+** message naming file, line, section and key; the checks against this host
+** (bind address, CPU, retain folder); long lines; random damage. */
+#include <arpa/inet.h>
 #include <check.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <sched.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
 #include "config.h"
 #include "../common/check_run.h"
 
@@ -97,8 +105,8 @@ END_TEST
 
 START_TEST(values)
 {
-    bad("[modbus]\nport = abc\n", "plant.ini:2: [modbus] port: 'abc' is not an integer in 1..65535");
-    bad("[modbus]\nport = 70000\n", "[modbus] port: '70000' is not an integer");
+    bad("[modbus]\nport = abc\n", "plant.ini:2: [modbus] port: 'abc' is not a decimal integer in 1..65535");
+    bad("[modbus]\nport = 70000\n", "[modbus] port: '70000' is not a decimal integer in 1..65535");
     bad("[scan]\npriority = 100\n", "[scan] priority: '100'");
     bad("[scan]\nlock_memory = maybe\n", "[scan] lock_memory: 'maybe' is not yes or no");
     bad("[plc]\nlog_level = loud\n", "[plc] log_level: 'loud'");
@@ -132,6 +140,287 @@ START_TEST(missing_file)
 }
 END_TEST
 
+/* Ports and every other integer are decimal: a leading zero is not octal
+** (017353 octal would be 7915), 0x is not hexadecimal. */
+START_TEST(decimal)
+{
+    ck_assert_msg(load("[modbus]\nport = 017353\n[scan]\npriority = 010\ncpu = -01\n") == 0, "%s", err);
+    ck_assert_int_eq(c.mb_port, 17353);
+    ck_assert_int_eq(c.priority, 10);
+    ck_assert_int_eq(c.cpu, -1);
+    config_free(&c);
+    bad("[modbus]\nport = 0x10\n", "plant.ini:2: [modbus] port: '0x10' is not a decimal integer");
+    bad("[modbus]\nport = 0\n", "plant.ini:2: [modbus] port: '0' is not a decimal integer in 1..65535");
+    bad("[modbus]\nport = 65536\n", "[modbus] port: '65536'");
+    bad("[modbus]\nport = 99999999999999999999\n", "[modbus] port: '99999999999999999999'");
+    bad("[modbus]\nport = 15 02\n", "[modbus] port: '15 02'");
+    bad("[modbus.symbols]\nA.B = holding 0x10\n", "plant.ini:2: [modbus.symbols] A.B: address '0x10'");
+    ck_assert_msg(load("[modbus.symbols]\nA.B = holding 010\n") == 0, "%s", err);
+    ck_assert_int_eq(c.symbols[0].addr, 10);
+    config_free(&c);
+}
+END_TEST
+
+/* A host name is resolved once, to the IPv4 address the server listens on
+** ("localhost" is 127.0.0.1 in every /etc/hosts); what the IPv4-only
+** server cannot listen on is refused at its line. */
+START_TEST(bind_names)
+{
+    ck_assert_msg(load("[modbus]\nbind = localhost\n") == 0, "%s", err);
+    ck_assert_str_eq(c.mb_bind, "127.0.0.1");
+    ck_assert_str_eq(c.mb_bind_name, "localhost");
+    config_free(&c);
+    ck_assert_msg(load("[modbus]\nbind = 0.0.0.0\n") == 0, "%s", err);
+    ck_assert_str_eq(c.mb_bind, "0.0.0.0");
+    ck_assert_str_eq(c.mb_bind_name, "");
+    config_free(&c);
+    bad("[modbus]\nport = 1502\nbind = ::1\n", "plant.ini:3: [modbus] bind: '::1' is an IPv6 address");
+    bad("[modbus]\nbind = fe80::1\n", "plant.ini:2: [modbus] bind: 'fe80::1' is an IPv6 address");
+    bad("[modbus]\nbind = 127.0.0.1:502\n", "plant.ini:2: [modbus] bind: '127.0.0.1:502' is not an address");
+    bad("[modbus]\nbind = 255.255.255.255\n", "plant.ini:2: [modbus] bind: '255.255.255.255' is a broadcast address");
+    bad("[modbus]\nbind = 224.0.0.1\n", "[modbus] bind: '224.0.0.1' is a multicast address");
+    bad("[modbus]\nbind = 010.0.0.1\n", "[modbus] bind: '010.0.0.1' is not an IPv4 address");
+    bad("[modbus]\nbind = 127.1\n", "[modbus] bind: '127.1' is not an IPv4 address");
+    bad("[modbus]\nbind = 0.1.2.3\n", "[modbus] bind: '0.1.2.3' is not an address of a host");
+    bad("[modbus]\nbind =\n", "plant.ini:2: [modbus] bind: empty");
+}
+END_TEST
+
+/* An address of the documentation ranges (RFC 5737) that this host cannot
+** bind, found with a plain bind(); NULL if it has them all. */
+static const char *foreign_address(void)
+{
+    static const char *cand[] = { "192.0.2.1", "198.51.100.1", "203.0.113.1", "192.0.2.254" };
+    for (size_t i = 0; i < sizeof cand / sizeof cand[0]; i++) {
+        int fd = socket(AF_INET, SOCK_STREAM, 0);
+        struct sockaddr_in sa = { .sin_family = AF_INET };
+        inet_pton(AF_INET, cand[i], &sa.sin_addr);
+        int r = bind(fd, (struct sockaddr *)&sa, sizeof sa), e = errno;
+        close(fd);
+        if (r && e == EADDRNOTAVAIL) return cand[i];
+    }
+    return NULL;
+}
+
+START_TEST(bind_host)
+{
+    const char *a = foreign_address();
+    ck_assert_msg(a != NULL, "every candidate address is on this host");
+    char t[200], want[200];
+    snprintf(t, sizeof t, "[modbus]\nport = 1502\nbind = %s\n", a);
+    ck_assert_msg(load(t) == 0, "%s", err);           /* a good address, of another host */
+    ck_assert_int_eq(config_check_host(&c, 0, err, sizeof err), -1);
+    snprintf(want, sizeof want, "plant.ini:3: [modbus] bind: %s is not an address of this host", a);
+    ck_assert_msg(strstr(err, want) != NULL, "message '%s' lacks '%s'", err, want);
+    config_free(&c);
+    /* not served: not checked against this host */
+    snprintf(t, sizeof t, "[modbus]\nenabled = no\nbind = %s\n", a);
+    ck_assert_msg(load(t) == 0, "%s", err);
+    ck_assert_msg(config_check_host(&c, 0, err, sizeof err) == 0, "%s", err);
+    config_free(&c);
+    ck_assert_msg(load("[modbus]\nbind = localhost\n[retain]\nfile =\n") == 0, "%s", err);
+    ck_assert_msg(config_check_host(&c, 1, err, sizeof err) == 0, "%s", err);
+    config_free(&c);
+}
+END_TEST
+
+START_TEST(cpu_host)
+{
+    cpu_set_t set;
+    ck_assert_int_eq(sched_getaffinity(0, sizeof set, &set), 0);
+    int missing = -1;
+    for (int i = 0; i < 1024 && missing < 0; i++) if (!CPU_ISSET(i, &set)) missing = i;
+    char t[100], want[100];
+    snprintf(t, sizeof t, "[retain]\nfile =\n[scan]\ncpu = %d\n", missing);
+    ck_assert_msg(load(t) == 0, "%s", err);
+    ck_assert_int_eq(config_check_host(&c, 0, err, sizeof err), -1);
+    snprintf(want, sizeof want, "plant.ini:4: [scan] cpu: CPU %d is not one this process may run on", missing);
+    ck_assert_msg(strstr(err, want) != NULL, "message '%s' lacks '%s'", err, want);
+    config_free(&c);
+}
+END_TEST
+
+/* The retain file is written beside itself (temporary file, rename): its
+** folder must exist and be writable. */
+START_TEST(retain_host)
+{
+    ck_assert_msg(load("[plc]\n[retain]\nfile = /nonexistent-plc/var/plc.retain\n") == 0, "%s", err);
+    ck_assert_int_eq(config_check_host(&c, 0, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "plant.ini:3: [retain] file: folder /nonexistent-plc/var: No such file") != NULL, "%s", err);
+    config_free(&c);
+    char d[200];
+    snprintf(d, sizeof d, "[retain]\nfile = %s\n", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    ck_assert_msg(load(d) == 0, "%s", err);
+    ck_assert_int_eq(config_check_host(&c, 0, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "plant.ini:2: [retain] file: ") && strstr(err, "is not a regular file"), "%s", err);
+    config_free(&c);
+    /* the default file, in the working folder, when the program retains */
+    ck_assert_msg(load("") == 0, "%s", err);
+    ck_assert_msg(config_check_host(&c, 1, err, sizeof err) == 0, "%s", err);
+    config_free(&c);
+}
+END_TEST
+
+START_TEST(folder)
+{
+    char e[600];
+    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    ck_assert_int_eq(config_defaults(&c, e, sizeof e), 0);
+    ck_assert_int_eq(config_load(&c, dir, err, sizeof err), -1);
+    char want[300];
+    snprintf(want, sizeof want, "%s: is a folder, not a configuration file", dir);
+    ck_assert_msg(strstr(err, want) != NULL, "message '%s' lacks '%s'", err, want);
+    config_free(&c);
+}
+END_TEST
+
+/* libinih's own buffer holds 199 characters: longer lines up to
+** CFG_MAX_LINE are read whole and keep their line numbers. */
+START_TEST(long_lines)
+{
+    char t[6000], vars[3000] = "";
+    /* a 207-character status_vars line: 7 paths of 22 characters, one of 25 */
+    for (int i = 0; i < 8; i++)
+        snprintf(vars + strlen(vars), sizeof vars - strlen(vars), "%sCONFIG0.RES0.INST0.V%02d%s",
+                 i ? ", " : "", i, i == 7 ? "XYZ" : "");
+    snprintf(t, sizeof t, "status_vars = %s", vars);
+    ck_assert_int_eq(strlen(t), 207);
+    snprintf(t, sizeof t, "[plc]\nstatus_vars = %s\n[scan]\npriority = 5\n", vars);
+    ck_assert_msg(load(t) == 0, "%s", err);
+    ck_assert_int_eq(c.nstatus, 8);
+    ck_assert_str_eq(c.status_vars[0], "CONFIG0.RES0.INST0.V00");
+    ck_assert_str_eq(c.status_vars[7], "CONFIG0.RES0.INST0.V07XYZ");
+    ck_assert_int_eq(c.priority, 5);
+    ck_assert_int_eq(config_line(&c, "plc", "status_vars"), 2);
+    ck_assert_int_eq(config_line(&c, "scan", "priority"), 4);
+    config_free(&c);
+    /* an error after long lines is at its own line */
+    snprintf(t, sizeof t, "[plc]\nstatus_vars = %s\n; %0300d\n\n[scan]\npriorty = 5\n", vars, 0);
+    bad(t, "plant.ini:6: [scan] priorty: unknown key");
+    /* a long line's inline comment, indent and CRLF, as on a short line */
+    snprintf(t, sizeof t, "[plc]\r\n  status_vars = A.B ; %0300d \r\n", 0);
+    ck_assert_msg(load(t) == 0, "%s", err);
+    ck_assert_int_eq(c.nstatus, 1);
+    ck_assert_str_eq(c.status_vars[0], "A.B");
+    config_free(&c);
+    /* a long key: a symbol path of 159 characters, and its line */
+    char path[160];
+    memset(path, 'P', 159);
+    path[159] = 0;
+    memcpy(path, "CONFIG0.", 8);
+    snprintf(t, sizeof t, "[modbus.symbols]\nA.B = holding 1\n%s = holding 9000 rw ; wide\n", path);
+    ck_assert_msg(load(t) == 0, "%s", err);
+    ck_assert_int_eq(c.nsymbols, 2);
+    ck_assert_str_eq(c.symbols[1].path, path);
+    ck_assert_int_eq(c.symbols[1].addr, 9000);
+    ck_assert_int_eq(c.symbols[1].writable, 1);
+    ck_assert_int_eq(c.symbols[1].line, 3);
+    config_free(&c);
+    /* long bad lines: a value, a section, no '=' */
+    snprintf(t, sizeof t, "[modbus]\nport = %0250dx\n", 0);
+    bad(t, "plant.ini:2: [modbus] port: '0000");
+    snprintf(t, sizeof t, "[scan]\n[x%0250d]\nkey = 1\n", 0);
+    bad(t, "plant.ini:3: [x0000");
+    snprintf(t, sizeof t, "[scan]\npriority = 1\n%0250d\n", 0);
+    bad(t, "plant.ini:3: syntax error");
+    /* beyond the maximum: refused at its own line */
+    char *big = malloc(CFG_MAX_LINE + 200);
+    ck_assert_ptr_nonnull(big);
+    int n = snprintf(big, CFG_MAX_LINE + 200, "[plc]\nlog_level = info\nstatus_vars = ");
+    memset(big + n, 'A', CFG_MAX_LINE + 1 - 14);
+    strcpy(big + n + CFG_MAX_LINE + 1 - 14, "\n[scan]\npriority = 1\n");
+    char want[120];
+    snprintf(want, sizeof want, "plant.ini:3: [plc] status_vars: line of %d characters; at most %d", CFG_MAX_LINE + 1, CFG_MAX_LINE);
+    bad(big, want);
+    free(big);
+}
+END_TEST
+
+START_TEST(whole)
+{
+    bad("[modbus]\nport = 1502\n\nport = 1503\n", "plant.ini:4: [modbus] port: given twice (first on line 2)");
+    bad("[plc]\nlog_level = in\001fo\n", "plant.ini:2: [plc] log_level: control character 0x01 in column 15");
+    bad("[plc]\nstatus_vars = A, B, C, D, E, F, G, H, I\n", "plant.ini:2: [plc] status_vars: more than 8 variables");
+    /* the first error in the file wins, whatever finds it */
+    bad("[modbus]\nport = x\n[io]\nbackend = profibus\n", "plant.ini:2: [modbus] port");
+    bad("[io]\nbackend = profibus\n[modbus]\nport = x\n", "plant.ini:2: [io] backend");
+    bad("[modbus]\nport = x\nbad line\n", "plant.ini:2: [modbus] port");
+    /* an indent is not a continuation of the value above (libinih's
+    ** multi-line values): a line like any other */
+    ck_assert_msg(load("[modbus]\n  port = 1600\n\tbind = localhost\n") == 0, "%s", err);
+    ck_assert_int_eq(c.mb_port, 1600);
+    ck_assert_str_eq(c.mb_bind, "127.0.0.1");
+    config_free(&c);
+    bad("[plc]\nstatus_vars = A.B,\n    C.D\n", "plant.ini:3: syntax error");
+    /* a byte order mark is not part of the first line */
+    ck_assert_msg(load("\xEF\xBB\xBF[modbus]\nport = 1600\n") == 0, "%s", err);
+    ck_assert_int_eq(c.mb_port, 1600);
+    config_free(&c);
+}
+END_TEST
+
+/* Later checks (program, host) word their messages the same way; a key
+** left at its default is named as such. */
+START_TEST(messages)
+{
+    ck_assert_msg(load("[scan]\n\npriority = 5\n") == 0, "%s", err);
+    char m[300];
+    config_msg(&c, "scan", "priority", m, sizeof m, "refused by %s", "the kernel");
+    ck_assert_str_eq(m, "plant.ini:3: [scan] priority: refused by the kernel");
+    config_msg(&c, "retain", "file", m, sizeof m, "folder %s: gone", ".");
+    ck_assert_str_eq(m, "plant.ini: [retain] file (default): folder .: gone");
+    ck_assert_int_eq(config_line(&c, "scan", "priority"), 3);
+    ck_assert_int_eq(config_line(&c, "scan", "cpu"), 0);
+    ck_assert_int_eq(config_line(&c, "nosuch", "key"), 0);
+    config_free(&c);
+}
+END_TEST
+
+/* Bad files never crash (this suite also runs under ASan/UBSan): a good
+** file with bytes changed, inserted or dropped at random. */
+START_TEST(robust)
+{
+    static const char good[] =
+        "[plc]\nlog_level = debug\nstatus_interval = 2\n"
+        "[scan]\npriority = 0\ncpu = 1\nlock_memory = no\n"
+        "[io]\nbackend = sim\n[sim.axis0]\ndac = %QW4\nmaxvel = 5e4\n"
+        "[modbus.symbols]\nCONFIG0.X = holding 9000 rw\n[retain]\nperiod = 0\n"
+        "[plc]\nstatus_vars = CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.ONE, CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.TWO, "
+        "CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.THREE, CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.FOUR ; and a comment\n"
+        "  [modbus.symbols] ; a long section line, indented ...........................................\n"
+        "CONFIG0.RES0.LONG.NAME.OF.A.VARIABLE.ONE.AT.THE.HOLDING.REGISTERS.OF.THE.MAP.AND.MORE.TEXT = holding 300\n";
+    static const char bytes[] = "[]=;:# \t\n\r,.%0123456789aAzZ\001\377";
+    char t[1200];
+    unsigned seed = 12345;
+    int accepted = 0, refused = 0;
+    ck_assert_msg(load(good) == 0, "%s", err);
+    ck_assert_int_eq(c.nstatus, 4);
+    ck_assert_int_eq(c.nsymbols, 2);
+    config_free(&c);
+    for (int k = 0; k < 3000; k++) {
+        strcpy(t, good);
+        size_t len = strlen(t);
+        for (int m = 0; m < 3; m++) {
+            size_t at = (size_t)rand_r(&seed) % len;
+            char b = bytes[(size_t)rand_r(&seed) % (sizeof bytes - 1)];
+            switch (rand_r(&seed) % 3) {
+            case 0: t[at] = b; break;
+            case 1: if (len < sizeof t - 2) { memmove(t + at + 1, t + at, len - at + 1); t[at] = b; len++; } break;
+            default: memmove(t + at, t + at + 1, len - at); len--; break;
+            }
+        }
+        if (load(t) == 0) accepted++;
+        else {
+            refused++;
+            ck_assert_msg(!strncmp(err, "plant.ini:", 10), "message '%s'", err);
+        }
+        config_free(&c);
+    }
+    ck_assert_int_gt(refused, 1000);
+    ck_assert_int_gt(accepted, 10);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("config");
@@ -144,6 +433,16 @@ int main(void)
     tcase_add_test(t, values);
     tcase_add_test(t, first_error_wins);
     tcase_add_test(t, missing_file);
+    tcase_add_test(t, decimal);
+    tcase_add_test(t, bind_names);
+    tcase_add_test(t, bind_host);
+    tcase_add_test(t, cpu_host);
+    tcase_add_test(t, retain_host);
+    tcase_add_test(t, folder);
+    tcase_add_test(t, long_lines);
+    tcase_add_test(t, whole);
+    tcase_add_test(t, messages);
+    tcase_add_test(t, robust);
     suite_add_tcase(s, t);
     return check_run(s);
 }

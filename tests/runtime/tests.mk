@@ -70,3 +70,10 @@ test-runtime-overrun: $(BUILD)/plc/rt_spin/plcrt
 	@mk/suite.sh $(RESULTS) runtime-overrun python3 tests/runtime/test_overrun.py \
 	  $(BUILD)/plc/rt_spin/plcrt $(abspath $(RT_T))/overrun
 TESTS += test-runtime-overrun
+# the configuration checked whole: --check-config and the start on
+# temporary files (docs/config.md)
+.PHONY: test-runtime-config
+test-runtime-config: $(BUILD)/plc/rt_iotest/plcrt
+	@mk/suite.sh $(RESULTS) runtime-config python3 tests/runtime/test_config.py \
+	  $(BUILD)/plc/rt_iotest/plcrt $(abspath $(RT_T))/config
+TESTS += test-runtime-config
