@@ -25,3 +25,6 @@ TESTS += test-stc-run test-stc-errors test-stc-contract
 
 # ---- examples: the example programs under plcrt, over Modbus ----
 include tests/examples/tests.mk
+
+# ---- apossctl: the APOSS controller part ----
+include tests/apossctl/apossctl.mk
