@@ -10,13 +10,26 @@ STC     := $(BUILD)/stc/stc
 STC_INC := stc/include
 RESULTS := $(BUILD)/results
 
+# make test-matiec: the suites of MATIEC_TESTS built again with upstream
+# matiec's iec2c (MATIEC_DIR: where it was built by hand, outside this
+# tree; docs/stc.md) in build-matiec/, to show both compilers give the same
+# results. Never part of `make test`.
+ifeq ($(COMPILER),matiec)
+STC     := mk/iec2c.sh
+STC_INC := $(MATIEC_DIR)/lib/C
+export MATIEC_DIR
+# matiec's output is not written for -Wall -Werror
+CFLAGS  := -std=gnu11 -O2 -g -D_DEFAULT_SOURCE -D_GNU_SOURCE -w
+endif
+
 ALL     :=
 TESTS   :=
+MATIEC_TESTS :=
 BENCHES :=
 FUZZES  :=
 RUN_DEMO :=
 
-.PHONY: all deps test run bench fuzz clean check-results
+.PHONY: all deps test run bench fuzz clean check-results test-matiec
 all:
 
 include $(wildcard stc/part.mk) $(wildcard c_blocks/part.mk) $(wildcard st/part.mk)
@@ -36,6 +49,16 @@ test:
 	@$(MAKE) --no-print-directory -k $(TESTS) || touch $(RESULTS)/.make-failed
 	@mk/summary.sh $(RESULTS)
 
+test-matiec:
+	@if [ -z "$(MATIEC_DIR)" ] || [ ! -x "$(MATIEC_DIR)/iec2c" ]; then \
+	  echo "test-matiec: set MATIEC_DIR to the folder where matiec's iec2c was built (docs/stc.md says how)"; \
+	  exit 2; fi
+	@mk/deps.sh
+	@rm -rf build-matiec/results && mkdir -p build-matiec/results
+	@$(MAKE) --no-print-directory -k COMPILER=matiec BUILD=build-matiec \
+	  RESULTS=build-matiec/results $(MATIEC_TESTS) || touch build-matiec/results/.make-failed
+	@mk/summary.sh build-matiec/results
+
 run:
 	@mk/deps.sh
 	@$(MAKE) --no-print-directory all
@@ -51,4 +74,4 @@ fuzz:
 	@$(MAKE) --no-print-directory $(FUZZES)
 
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) build-matiec

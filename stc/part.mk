@@ -3,13 +3,14 @@ STC_SRCS := $(wildcard stc/*.c)
 STC_OBJS := $(patsubst stc/%.c,$(BUILD)/stc/%.o,$(STC_SRCS))
 STC_DEFS := -DSTC_INCLUDE_DIR='"$(abspath stc/include)"'
 
-ALL += $(STC)
+STC_BIN  := $(BUILD)/stc/stc
+ALL += $(STC_BIN)
 
 $(BUILD)/stc/%.o: stc/%.c stc/stc.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(STC_DEFS) -c -o $@ $<
 
-$(STC): $(STC_OBJS)
+$(STC_BIN): $(STC_OBJS)
 	$(CC) $(CFLAGS) -o $@ $^ -lm
 
 # ---- unit tests of the compiler's stages (Check), plain and sanitized ----

@@ -3,6 +3,7 @@
 EPICPOS_TESTS := $(wildcard tests/epicpos/t_*.st)
 
 TESTS += test-epicpos
+MATIEC_TESTS += test-epicpos
 
 .PHONY: test-epicpos
 test-epicpos: $(ST_LIB) $(STC)
