@@ -5,7 +5,7 @@
 void plant_defaults(plant_params *p)
 {
     *p = (plant_params){
-        .maxvel = 100000, .lag = 0.02, .counts_per_rev = 4000,
+        .maxvel = 100000, .lag = 0.005, .counts_per_rev = 4000,
         .resonance = 0, .damping = 0.1, .cam_low = 1, .cam_high = 0,
     };
 }

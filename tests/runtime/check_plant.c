@@ -17,14 +17,15 @@ static void run(plant_params *p, int16_t dac, int steps, double dt)
 START_TEST(lag_response)
 {
     plant_params p;
-    plant_defaults(&p);           /* maxvel 100000, lag 0.02 */
+    plant_defaults(&p);           /* maxvel 100000, lag 0.005 (docs/config.md) */
+    ck_assert(p.maxvel == 100000 && p.lag == 0.005);
     run(&p, 16384, 1000, 1e-3);
     double v = 100000 * (16384 * 10.0 / 32767) / 10;            /* 50001.5 counts/s */
-    double x = v * (1.0 - 0.02);                                 /* 49001.5 */
+    double x = v * (1.0 - 0.005);                                /* 49751.5 */
     ck_assert_msg(fabs(plant_counter(&s) - x) <= 5, "counter %d, expected %.1f", plant_counter(&s), x);
     ck_assert_msg(fabs(s.vl - v) < 1, "speed %.1f", s.vl);
-    /* a third of the way: 1 - e^-1 of the speed after one lag */
-    run(&p, 16384, 20, 1e-3);
+    /* two thirds of the way: 1 - e^-1 of the speed after one lag */
+    run(&p, 16384, 5, 1e-3);
     ck_assert_msg(fabs(s.vm - v * (1 - exp(-1))) < 0.01 * v, "speed after one lag %.1f", s.vm);
 }
 END_TEST
@@ -55,12 +56,12 @@ START_TEST(dead_band_offset_drift)
     ck_assert_int_eq(plant_counter(&s), 0);
     plant_defaults(&p);
     p.offset = 0.1;               /* 0.1 V = 1000 counts/s with the DAC at 0 */
-    run(&p, 0, 1000, 1e-3);
-    ck_assert_msg(abs(plant_counter(&s) - 980) <= 2, "offset: %d", plant_counter(&s));
+    run(&p, 0, 1000, 1e-3);       /* x(1) = 1000 (1 - lag) = 995 */
+    ck_assert_msg(abs(plant_counter(&s) - 995) <= 2, "offset: %d", plant_counter(&s));
     plant_defaults(&p);
-    p.drift = 0.1;                /* v(t) = 1000 t: x(1) = 500 - lag effect (~20) */
+    p.drift = 0.1;                /* v(t) = 1000 t: x(1) = 500 - 1000 lag (5) */
     run(&p, 0, 1000, 1e-3);
-    ck_assert_msg(abs(plant_counter(&s) - 480) <= 5, "drift: %d", plant_counter(&s));
+    ck_assert_msg(abs(plant_counter(&s) - 495) <= 3, "drift: %d", plant_counter(&s));
 }
 END_TEST
 
