@@ -290,17 +290,20 @@ int main(int argc, char **argv)
         }
     }
 
-    /* shutdown: outputs safe first, then land acknowledged writes, save */
+    /* shutdown: stop the scan and the server (requests in flight get their
+    ** replies), land what was acknowledged (so that a retained value is the
+    ** last one a client was told was written), then outputs to their safe
+    ** state: nothing lands in the outputs after that. Then save. */
     atomic_store(&sc.stop, 1);
     pthread_join(th, NULL);
+    mb_server_stop(srv);
+    if (mb) mb_drain(mb, &plc_img);
     memset(plc_img.qx, 0, sizeof plc_img.qx);
     memset(plc_img.qb, 0, sizeof plc_img.qb);
     memset(plc_img.qw, 0, sizeof plc_img.qw);
     memset(plc_img.qd, 0, sizeof plc_img.qd);
     memset(plc_img.ql, 0, sizeof plc_img.ql);
     cfg.io->safe_state(cfg.io_state, &plc_img);
-    mb_server_stop(srv);
-    if (mb) mb_apply(mb, &plc_img);
     retain_now(&sc, &ret, &cfg, 0);
     stats_print(stderr, &sc.stats, period);
     cfg.io->close(cfg.io_state);

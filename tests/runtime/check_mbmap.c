@@ -87,7 +87,9 @@ static void write_coils(unsigned a, unsigned n, const uint8_t *bits)
 #define EXC(fc, code) do { ck_assert_uint_eq(rn, 2); ck_assert_uint_eq(rsp[0], (fc) | 0x80); ck_assert_uint_eq(rsp[1], code); } while (0)
 #define OK(fc) do { ck_assert_msg(rsp[0] == (fc), "exception %u", rsp[1]); } while (0)
 static unsigned reg(int i) { return (unsigned)rsp[2 + 2 * i] << 8 | rsp[3 + 2 * i]; }
-static void cycle(void) { mb_apply(m, &img); mb_publish(m, &img, NULL); }
+/* The server's turn (take the newest snapshot, hand writes over), then a
+** cycle's start and end. */
+static void cycle(void) { mb_flush(m); mb_apply(m, &img); mb_publish(m, &img, NULL); }
 
 START_TEST(coils_edges)
 {
@@ -282,6 +284,9 @@ START_TEST(many_writes_between_cycles)
     uint8_t bits[1968];
     for (int i = 0; i < 1968; i++) bits[i] = (uint8_t)(i & 1);
     for (unsigned a = 0; a < 8192 - 1968; a += 1968) { write_coils(a, 1968, bits); OK(15); }
+    /* the first write went to the scan at once; all the others, one
+    ** element each, in the next batch: two cycles land everything */
+    cycle();
     cycle();
     /* the last write at 0 (%QW0..122) was i = 1992: register k = 1992 + k */
     ck_assert_int_eq(img_get16(img.qw, 0), 1992);
