@@ -17,6 +17,7 @@
 #define MS             1000000ull
 #define FRAME_NS       (500 * MS)    /* a frame's last byte after its first */
 #define SEND_NS        (2000 * MS)   /* a reply the client does not take */
+#define WRITES_NS      (MS / 4)      /* while writes wait for the scan */
 #define MBAP           7             /* transaction, protocol, length, unit */
 #define ADU_MAX        260           /* Modbus TCP's largest frame */
 
@@ -172,8 +173,9 @@ static void *server_thread(void *arg)
     while (!atomic_load(&s->stop)) {
         uint64_t now = scan_now_ns();
         uint64_t next = expire(s, now);
-        int timeout = (int)((next - now + MS - 1) / MS);
-        if (mb_flush(s->m)) timeout = 1;              /* hand writes over each period */
+        uint64_t wait = next - now;
+        if (mb_flush(s->m) && wait > WRITES_NS) wait = WRITES_NS;   /* hand writes over soon */
+        struct timespec to = { (time_t)(wait / 1000000000u), (long)(wait % 1000000000u) };
         int listening = now >= s->listen_pause;
         s->pf[0] = (struct pollfd){ s->wake, POLLIN, 0 };
         s->pf[1] = (struct pollfd){ listening ? s->lfd : -1, POLLIN, 0 };
@@ -183,7 +185,7 @@ static void *server_thread(void *arg)
             s->pf[2 + i] = (struct pollfd){ c->fd, ev, 0 };
         }
         int nc = s->n;
-        if (poll(s->pf, (nfds_t)(2 + nc), timeout) <= 0) continue;
+        if (ppoll(s->pf, (nfds_t)(2 + nc), &to, NULL) <= 0) continue;
         now = scan_now_ns();
         /* clients first (the array is packed: walk it from the end, so that
         ** dropping one moves a client already handled) */
