@@ -67,6 +67,8 @@ def plcrt_stats(text):
     out["cycles"], out["overruns"] = int(m.group(1)), int(m.group(2))
     m = re.search(r"overruns: (\d+) with the program's execution alone over the period", text)
     out["own"] = int(m.group(1)) if m else 0
+    m = re.search(r"^exchange (-?\d+)$", text, re.M)
+    out["exchange"] = int(m.group(1)) if m else None
     for key, name in (("lat", "wake latency"), ("exec", "execution")):
         m = re.search(name + r"\s+min\s+([\d.]+)\s+mean\s+([\d.]+)\s+p99\s+([\d.]+)\s+p99.9\s+([\d.]+)\s+max\s+([\d.]+)", text)
         out[key] = dict(zip(("min", "mean", "p99", "p999", "max"), map(float, m.groups())))
@@ -124,11 +126,30 @@ def load(clients, seconds):
     return int(m.group(1))
 
 
+def exchange_us():
+    """Register 1070: the scan's longest Modbus exchange (docs/modbus.md)."""
+    with socket.create_connection(("127.0.0.1", PORT), timeout=3) as s:
+        s.sendall(bytes([0, 1, 0, 0, 0, 6, 1, 4, 1070 >> 8, 1070 & 255, 0, 2]))
+        r = b""
+        while len(r) < 13:
+            got = s.recv(13 - len(r))
+            if not got:
+                return -1
+            r += got
+    return int.from_bytes(r[9:13], "big")
+
+
 def plcrt_round(clients, seconds):
     p = start(P1, ini(modbus=True))
     wait_port()
     rate = load(clients, seconds)
-    return rate, plcrt_stats(stop(p))
+    st = plcrt_stats(stop_after(p, exchange_us()))
+    return rate, st
+
+
+def stop_after(p, xch):
+    text = stop(p)
+    return text + f"\nexchange {xch}\n"
 
 
 def ref_round(clients, seconds):
@@ -147,7 +168,7 @@ def modbus():
           f"plcrt scanning an empty program every 1 ms at SCHED_FIFO 80 beside the reference server "
           f"(libmodbus's modbus_reply, select(), nothing else); requests/s in total, medians:")
     for n in (1, 4, 16):
-        plc, ref, worst, over = [], [], [], []
+        plc, ref, worst, over, xch = [], [], [], [], []
         for r in range(rounds):
             order = (0, 1) if r % 2 == 0 else (1, 0)       # neither always goes first
             for which in order:
@@ -155,13 +176,15 @@ def modbus():
                     rate, st = plcrt_round(n, seconds)
                     plc.append(rate)
                     worst.append(st["exec"]["max"])
+                    xch.append(st["exchange"])
                     over.append(f"{st['overruns']}/{st['own']}")
                 else:
                     ref.append(ref_round(n, seconds))
         mp, mr = statistics.median(plc), statistics.median(ref)
         print(f"  {n:2d} client(s): plcrt {mp:8.0f}  reference {mr:8.0f}  ratio plcrt/reference {mp / mr:5.2f}  "
               f"(rounds plcrt {plc}, reference {ref}); scan: longest execution {max(worst):.1f} us "
-              f"(rounds {worst}), overruns in all/of its own {over}")
+              f"(rounds {worst}), of which the Modbus exchange at most {max(xch)} us (rounds {xch}), "
+              f"overruns in all/of its own {over}")
 
 
 def cost(st_mb):
