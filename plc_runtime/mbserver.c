@@ -29,6 +29,7 @@ typedef struct client {
     size_t nout;
     uint64_t frame_ns;               /* when the first byte of in[] came */
     uint64_t last_ns;                /* connected, or its last request served */
+    uint64_t last_seq;               /* the same as a rank: no two alike */
     uint64_t out_ns;                 /* when out[] began to wait */
 } client;
 
@@ -36,7 +37,7 @@ struct mb_server {
     mb_shared *m;
     modbus_t *listen_ctx;
     int lfd, wake, max, n;
-    uint64_t idle_ns, listen_pause;
+    uint64_t idle_ns, listen_pause, seq;
     pthread_t th;
     _Atomic int stop;
     client *cl;                      /* n in use, packed */
@@ -93,6 +94,7 @@ static int serve_frames(mb_server *s, client *c, uint64_t now)
         c->nout = pl + MBAP;
         c->out_ns = now;
         c->last_ns = now;
+        c->last_seq = ++s->seq;
         at += 6 + len;
         if (flush_out(c, now)) return -1;
     }
@@ -138,10 +140,10 @@ static void admit(mb_server *s, uint64_t now)
         if (s->n == s->max) {                 /* the longest idle gives way */
             int old = 0;
             for (int i = 1; i < s->n; i++)
-                if (s->cl[i].last_ns < s->cl[old].last_ns) old = i;
+                if (s->cl[i].last_seq < s->cl[old].last_seq) old = i;
             drop(s, old, &s->m->evicted);
         }
-        s->cl[s->n++] = (client){ .fd = fd, .last_ns = now };
+        s->cl[s->n++] = (client){ .fd = fd, .last_ns = now, .last_seq = ++s->seq };
         atomic_fetch_add(&s->m->clients, 1);
     }
 }

@@ -8,6 +8,7 @@ it from MODBUS_PORT)
 Prints PASS:/FAIL: lines; exits 1 if anything failed."""
 import os
 import re
+import select
 import signal
 import socket
 import struct
@@ -19,7 +20,7 @@ import time
 from pymodbus.client import ModbusTcpClient
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Plcrt, free_port  # noqa: E402
+from peer import Plcrt, free_port, wait_for  # noqa: E402
 
 PLCRT, RANDOM_CLIENT, WORK = sys.argv[1], sys.argv[2], sys.argv[4]
 PORT = free_port() if sys.argv[3] == "auto" else int(sys.argv[3])
@@ -228,7 +229,21 @@ def test_flood():
     c.close()
     time.sleep(0.1)
     socks = [socket.create_connection(("127.0.0.1", PORT)) for _ in range(40)]
-    time.sleep(0.3)                      # all accepted: each past the 16th pushed the oldest out
+
+    def closed():
+        """Indexes of the sockets the server closed (readable at end of file)."""
+        r, _, _ = select.select(socks, [], [], 0)
+
+        def at_eof(s):
+            try:
+                return s.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
+            except OSError:
+                return True
+        return sorted(i for i, s in enumerate(socks) if s in r and at_eof(s))
+    # each connection past the 16th pushes the longest idle out; wait for all
+    # of them to be accepted before sending anything (a request makes a
+    # client the most recently active)
+    gone = wait_for(lambda: len(closed()) >= 24 and closed(), 3, 0.05) or closed()
     served = []
     for i, s in enumerate(socks):
         s.settimeout(2)
@@ -240,7 +255,7 @@ def test_flood():
             pass
     # max_clients = 16: the 16 newest stay, the 24 before them gave way
     report("a flood of connections: the 16 newest are served, the older ones gave way",
-           served == list(range(24, 40)), f"served {served}")
+           gone == list(range(24)) and served == list(range(24, 40)), f"closed {gone}, served {served}")
     c = client()                         # one more: the longest idle gives way again
     ok = not c.read_holding_registers(0, 1, slave=1).isError()
     report("a new client is admitted while the cap is full", ok)
