@@ -5,15 +5,18 @@ BENCH_B := $(BUILD)/bench
 # plcrt: latency beside cyclictest, Modbus throughput, cost per cycle
 $(eval $(call plcrt_program,bench_empty,bench/runtime/empty.st))
 $(eval $(call plcrt_program,bench_empty250,bench/runtime/empty250.st))
-$(BENCH_B)/runtime/bandwidth-client: /usr/share/doc/libmodbus-dev/examples/bandwidth-client.c bench/part.mk
+
+# Modbus throughput: plcrt beside a reference server on libmodbus's
+# modbus_reply, under the same load client
+$(BENCH_B)/runtime/%: bench/runtime/%.c
 	@mkdir -p $(@D)
-	sed 's/1502)/atoi(getenv("MODBUS_PORT")))/; s/n_loop = 100000;/n_loop = 5000;/' $< > $@.c
-	$(CC) -O2 -w -o $@ $@.c $(shell pkg-config --cflags --libs libmodbus)
+	$(CC) $(CFLAGS) -o $@ $< $(shell pkg-config --cflags --libs libmodbus) -lpthread
 
 .PHONY: bench-runtime
-bench-runtime: $(BUILD)/plc/bench_empty/plcrt $(BUILD)/plc/bench_empty250/plcrt $(BENCH_B)/runtime/bandwidth-client
+bench-runtime: $(BUILD)/plc/bench_empty/plcrt $(BUILD)/plc/bench_empty250/plcrt $(BENCH_B)/runtime/refserver $(BENCH_B)/runtime/mbload
 	python3 bench/runtime/bench.py $(BUILD)/plc/bench_empty/plcrt $(BUILD)/plc/bench_empty250/plcrt \
-	  $(BENCH_B)/runtime/bandwidth-client auto $(abspath $(BENCH_B))/runtime
+	  auto $(abspath $(BENCH_B))/runtime \
+	  $(BENCH_B)/runtime/refserver $(BENCH_B)/runtime/mbload
 BENCHES += bench-runtime
 
 # EPICPOS: instructions and ns per call, per scan with 1, 16 and 256 axes,

@@ -526,7 +526,7 @@ int config_defaults(plc_config *c, char *err, size_t errlen)
     strcpy(c->mb_bind, "127.0.0.1");
     c->mb_port = 1502;
     c->mb_max_clients = 16;
-    c->mb_idle_timeout = 60;
+    c->mb_idle_timeout = 10;
     strcpy(c->retain_file, "plcrt.retain");
     c->retain_period = 10;
     c->io = io_backend_find(c->backend);

@@ -154,6 +154,28 @@ static int configure(plc_config *cfg, const char *file, const plc_program *prog,
     return 0;
 }
 
+/* Stop the scan and the Modbus server (a request in flight gets its reply),
+** land what clients were told was written (so that a retained value is the
+** last one acknowledged), then the outputs to their safe state: nothing
+** lands in them after that. Save, print the statistics, release. */
+static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc_config *cfg, retained *ret)
+{
+    atomic_store(&sc->stop, 1);
+    pthread_join(th, NULL);
+    mb_server_stop(srv);
+    if (mb) mb_drain(mb, &plc_img);
+    memset(plc_img.qx, 0, sizeof plc_img.qx);
+    memset(plc_img.qb, 0, sizeof plc_img.qb);
+    memset(plc_img.qw, 0, sizeof plc_img.qw);
+    memset(plc_img.qd, 0, sizeof plc_img.qd);
+    memset(plc_img.ql, 0, sizeof plc_img.ql);
+    cfg->io->safe_state(cfg->io_state, &plc_img);
+    retain_now(sc, ret, cfg, 0);
+    stats_print(stderr, &sc->stats, sc->period_ns);
+    cfg->io->close(cfg->io_state);
+    mb_free(mb);
+}
+
 int main(int argc, char **argv)
 {
     static const struct option opts[] = {
@@ -319,20 +341,6 @@ int main(int argc, char **argv)
         }
     }
 
-    /* shutdown: outputs safe first, then land acknowledged writes, save */
-    atomic_store(&sc.stop, 1);
-    pthread_join(th, NULL);
-    memset(plc_img.qx, 0, sizeof plc_img.qx);
-    memset(plc_img.qb, 0, sizeof plc_img.qb);
-    memset(plc_img.qw, 0, sizeof plc_img.qw);
-    memset(plc_img.qd, 0, sizeof plc_img.qd);
-    memset(plc_img.ql, 0, sizeof plc_img.ql);
-    cfg.io->safe_state(cfg.io_state, &plc_img);
-    mb_server_stop(srv);
-    if (mb) mb_apply(mb, &plc_img);
-    retain_now(&sc, &ret, &cfg, 0);
-    stats_print(stderr, &sc.stats, period);
-    cfg.io->close(cfg.io_state);
-    mb_free(mb);
+    shut_down(&sc, th, srv, mb, &cfg, &ret);
     return 0;
 }

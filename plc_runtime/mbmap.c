@@ -9,7 +9,7 @@
 /* ---- cells: one addressable unit of a table ---------------------------- */
 
 typedef struct cell {
-    uint8_t *p;          /* element storage in the shadow */
+    uint8_t *p;          /* element storage in the server's view */
     unsigned size;       /* bytes of the element */
     unsigned nwords, w;  /* registers of the element, this one's index (0 = most significant) */
     int writable, is_bool;
@@ -29,19 +29,19 @@ static int item_cell(mb_shared *m, int table, unsigned a, cell *c)
 {
     mb_item *it = find_item(m, table, a);
     if (!it) return -1;
-    *c = (cell){ it->shadow, it->size, it->nregs, a - it->addr, it->writable,
+    *c = (cell){ m->snap[m->front].items[it - m->items], it->size, it->nregs, a - it->addr, it->writable,
                  it->is_bool, MB_REC_ITEM | (uint32_t)(it - m->items) };
     return 0;
 }
 
 static void img_cell(mb_shared *m, uint8_t *p, unsigned size, unsigned nwords, unsigned w, int writable, cell *c)
 {
-    *c = (cell){ p, size, nwords, w, writable, 0, (uint32_t)(p - (uint8_t *)&m->shadow) };
+    *c = (cell){ p, size, nwords, w, writable, 0, (uint32_t)(p - (uint8_t *)&m->snap[m->front].img) };
 }
 
 static int resolve(mb_shared *m, int table, unsigned a, cell *c)
 {
-    plc_image *s = &m->shadow;
+    plc_image *s = &m->snap[m->front].img;
     switch (table) {
     case MB_COILS:
         if (a < MB_BITS) { img_cell(m, s->qx + a, 1, 1, 0, 1, c); c->is_bool = 1; return 0; }
@@ -52,7 +52,7 @@ static int resolve(mb_shared *m, int table, unsigned a, cell *c)
     case MB_INPUT:
         if (a < MB_INPUT_IMG) { img_cell(m, s->iw + 2 * a, 2, 1, 0, 0, c); return 0; }
         if (a >= MB_DIAG_BASE && a < MB_DIAG_BASE + MB_DIAG_N) {
-            *c = (cell){ (uint8_t *)&m->diag[a - MB_DIAG_BASE], 2, 1, 0, 0, 0, 0 };
+            *c = (cell){ (uint8_t *)&m->snap[m->front].diag[a - MB_DIAG_BASE], 2, 1, 0, 0, 0, 0 };
             return 0;
         }
         break;
@@ -94,7 +94,7 @@ static uint16_t cell_get(const cell *c)
     return (uint16_t)(x >> (16 * (c->nwords - 1 - c->w)));
 }
 
-/* Update the shadow and log the whole element. */
+/* Update the view and record the whole element in the batch filling. */
 static void cell_set(mb_shared *m, const cell *c, uint16_t v)
 {
     if (c->is_bool) store(c->p, c->size, v != 0);
@@ -106,8 +106,9 @@ static void cell_set(mb_shared *m, const cell *c, uint16_t v)
     }
     uint32_t *ix = (c->target & MB_REC_ITEM) ? &m->item_idx[c->target & ~MB_REC_ITEM]
                                               : &m->img_idx[c->target];
-    mb_rec *r = *ix ? &m->log[*ix - 1] : &m->log[m->nlog++];
-    if (!*ix) *ix = (uint32_t)m->nlog;
+    mb_batch *b = m->fill;
+    mb_rec *r = *ix ? &b->rec[*ix - 1] : &b->rec[b->n++];
+    if (!*ix) *ix = (uint32_t)b->n;
     r->target = c->target;
     r->len = (uint8_t)c->size;
     memcpy(r->data, c->p, c->size);
@@ -136,7 +137,7 @@ static int check(mb_shared *m, int table, unsigned a, unsigned n, int write)
         if (resolve(m, table, a + i, &c)) return EX_ADDRESS;
         if (write && !c.writable) return EX_ADDRESS;
     }
-    if (write && m->nlog + n > MB_LOG_MAX) return EX_BUSY;
+    if (write && m->fill->n + n > MB_LOG_MAX) return EX_BUSY;
     return 0;
 }
 
@@ -247,44 +248,80 @@ size_t mb_process(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
 {
     atomic_fetch_add_explicit(&m->requests, 1, memory_order_relaxed);
     if (n < 1) return exc(m, rsp, 0, EX_FUNCTION);
-    pthread_mutex_lock(&m->lock);
+    mb_flush(m);                       /* serve from the newest snapshot */
     size_t r = serve(m, q, n, rsp);
-    pthread_mutex_unlock(&m->lock);
+    mb_flush(m);                       /* and hand a write over at once */
     return r;
 }
 
 /* ---- exchange with the scan -------------------------------------------- */
 
-static void replay(mb_shared *m, uint8_t *img_base, int to_shadow)
+/* Copy a batch's records into a snapshot (items: its symbol values) or, with
+** items NULL, into the scan's image and the program's variables. */
+static void replay(mb_shared *m, const mb_batch *b, plc_image *img, uint8_t (*items)[8])
 {
-    for (size_t i = 0; i < m->nlog; i++) {
-        mb_rec *r = &m->log[i];
+    for (size_t i = 0; i < b->n; i++) {
+        const mb_rec *r = &b->rec[i];
         if (r->target & MB_REC_ITEM) {
-            mb_item *it = &m->items[r->target & ~MB_REC_ITEM];
-            memcpy(to_shadow ? it->shadow : it->var, r->data, r->len);
+            size_t k = r->target & ~MB_REC_ITEM;
+            memcpy(items ? items[k] : m->items[k].var, r->data, r->len);
         } else {
-            memcpy(img_base + r->target, r->data, r->len);
+            memcpy((uint8_t *)img + r->target, r->data, r->len);
         }
     }
 }
 
-void mb_apply(mb_shared *m, plc_image *img)
+/* The server takes the newest snapshot as its view, with the writes it
+** does not hold yet: the batch handed over (unless landed before the
+** snapshot) and the one filling. */
+static void take_snapshot(mb_shared *m)
 {
-    pthread_mutex_lock(&m->lock);
-    replay(m, (uint8_t *)img, 0);
-    for (size_t i = 0; i < m->nlog; i++) {
-        uint32_t t = m->log[i].target;
+    if (!(atomic_load_explicit(&m->mid, memory_order_acquire) & MB_FRESH)) return;
+    unsigned old = atomic_exchange_explicit(&m->mid, m->front, memory_order_acq_rel);
+    m->front = old & 3u;
+    mb_snap *v = &m->snap[m->front];
+    if (v->applied < m->given->seq) replay(m, m->given, &v->img, v->items);
+    replay(m, m->fill, &v->img, v->items);
+}
+
+/* Hand the batch filling to the scan once the scan landed the previous one
+** and the view holds it (the previous batch's buffer is reused). */
+static void hand_over(mb_shared *m)
+{
+    mb_batch *b = m->fill;
+    if (!b->n || atomic_load_explicit(&m->ready, memory_order_acquire)) return;
+    if (m->snap[m->front].applied < m->given->seq) return;
+    for (size_t i = 0; i < b->n; i++) {
+        uint32_t t = b->rec[i].target;
         if (t & MB_REC_ITEM) m->item_idx[t & ~MB_REC_ITEM] = 0;
         else m->img_idx[t] = 0;
     }
-    m->nlog = 0;
-    pthread_mutex_unlock(&m->lock);
+    b->seq = m->given->seq + 1;
+    m->fill = m->given;
+    m->fill->n = 0;
+    m->given = b;
+    atomic_store_explicit(&m->ready, 1, memory_order_release);
+}
+
+int mb_flush(mb_shared *m)
+{
+    take_snapshot(m);
+    hand_over(m);
+    return m->fill->n > 0 || atomic_load_explicit(&m->ready, memory_order_relaxed);
+}
+
+void mb_apply(mb_shared *m, plc_image *img)
+{
+    if (!atomic_load_explicit(&m->ready, memory_order_acquire)) return;
+    replay(m, m->given, img, NULL);
+    m->landed = m->given->seq;
+    atomic_store_explicit(&m->ready, 0, memory_order_release);
 }
 
 void mb_publish(mb_shared *m, const plc_image *img, const uint16_t *diag)
 {
-    plc_image *s = &m->shadow;
-    pthread_mutex_lock(&m->lock);
+    mb_snap *b = &m->snap[m->back];
+    plc_image *s = &b->img;
     memcpy(s->ix, img->ix, sizeof s->ix);
     memcpy(s->qx, img->qx, sizeof s->qx);
     memcpy(s->iw, img->iw, sizeof s->iw);
@@ -293,10 +330,18 @@ void mb_publish(mb_shared *m, const plc_image *img, const uint16_t *diag)
     memcpy(s->md, img->md, sizeof s->md);
     memcpy(s->ml, img->ml, sizeof s->ml);
     for (size_t i = 0; i < m->nitems; i++)
-        memcpy(m->items[i].shadow, m->items[i].var, m->items[i].size);
-    if (diag) memcpy(m->diag, diag, sizeof m->diag);
-    replay(m, (uint8_t *)s, 1);
-    pthread_mutex_unlock(&m->lock);
+        memcpy(b->items[i], m->items[i].var, m->items[i].size);
+    if (diag) memcpy(b->diag, diag, sizeof b->diag);
+    b->applied = m->landed;
+    unsigned old = atomic_exchange_explicit(&m->mid, m->back | MB_FRESH, memory_order_acq_rel);
+    m->back = old & 3u;
+}
+
+void mb_drain(mb_shared *m, plc_image *img)
+{
+    mb_apply(m, img);
+    replay(m, m->fill, img, NULL);
+    m->fill->n = 0;
 }
 
 /* ---- set-up ------------------------------------------------------------ */
@@ -335,15 +380,15 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
     static const char *tabs[] = { "coil", "discrete input", "input register", "holding register" };
     mb_shared *m = calloc(1, sizeof *m);
     if (!m) { snprintf(err, errlen, "out of memory"); return NULL; }
-    pthread_mutexattr_t a;
-    pthread_mutexattr_init(&a);
-    pthread_mutexattr_setprotocol(&a, PTHREAD_PRIO_INHERIT);
-    pthread_mutex_init(&m->lock, &a);
-    pthread_mutexattr_destroy(&a);
-    if (c->nsymbols && (!(m->items = calloc((size_t)c->nsymbols, sizeof *m->items))
-                        || !(m->item_idx = calloc((size_t)c->nsymbols, sizeof *m->item_idx)))) {
-        free(m->items);
-        free(m);
+    m->front = 0; m->back = 2;
+    atomic_init(&m->mid, 1u);
+    m->fill = &m->batch[0];
+    m->given = &m->batch[1];
+    size_t ns = c->nsymbols ? (size_t)c->nsymbols : 1;
+    if (!(m->items = calloc(ns, sizeof *m->items)) || !(m->item_idx = calloc(ns, sizeof *m->item_idx))
+        || !(m->snap[0].items = calloc(ns, 8)) || !(m->snap[1].items = calloc(ns, 8))
+        || !(m->snap[2].items = calloc(ns, 8))) {
+        mb_free(m);
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
@@ -384,7 +429,7 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
 void mb_free(mb_shared *m)
 {
     if (!m) return;
-    pthread_mutex_destroy(&m->lock);
+    for (int i = 0; i < 3; i++) free(m->snap[i].items);
     free(m->items);
     free(m->item_idx);
     free(m);

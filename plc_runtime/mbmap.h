@@ -1,21 +1,31 @@
 /*
 ** mbmap.h: the Modbus address map (docs/modbus.md) and the exchange
-** between the Modbus threads and the scan.
+** between the Modbus server thread and the scan.
 **
-** Clients see a shadow of the image. A read copies from the shadow; a
-** write is checked whole (every address mapped and writable, values and
-** counts valid) before any of it lands, then goes to the shadow at once
-** (so a client reads back what it wrote) and into a log of pending
-** writes. At the start of each cycle the scan applies the log to the image
-** and to the program's variables (mb_apply); after the program ran it
-** copies the image into the shadow and replays writes logged meanwhile
-** (mb_publish). Both hold the lock for a copy only; a request holds it
-** while it is served, never across I/O.
+** The idea: the scan never waits for Modbus. It shares nothing with the
+** server that either side could hold; they trade whole buffers through
+** atomic index swaps.
+**
+** - Image out (scan -> server): a triple buffer of snapshots. At the end of
+**   each cycle the scan copies the image into its back snapshot and swaps
+**   it into the middle slot (mb_publish); the server takes the newest one
+**   when it serves a request. Neither ever waits for the other.
+** - Writes in (server -> scan): a batch handed over whole. A write request
+**   is checked whole (every address mapped and writable, values and counts
+**   valid) before any of it lands, then goes into the server's view at once
+**   (a client reads back what it wrote) and into the batch being filled,
+**   one record per element (a later write replaces the value, so no amount
+**   of writing fills it). The server hands a batch to the scan when the
+**   scan took the previous one in; at the start of a cycle the scan lands
+**   the batch handed to it, whole (mb_apply).
+**
+** Threads: mb_process and mb_flush belong to one server thread; mb_apply
+** and mb_publish to the scan; mb_drain to the main thread once both
+** stopped. The counters are read by anyone.
 */
 #ifndef MBMAP_H
 #define MBMAP_H
 
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -40,6 +50,7 @@ enum {
     MBD_TICK_US = 22, MBD_CLIENTS = 24, MBD_REFUSED = 26, MBD_REQUESTS = 28,
     MBD_EXCEPTIONS = 30, MBD_RETAIN_SAVES = 32, MBD_RETAIN_ERRORS = 34,
     MBD_IO_ERRORS = 36, MBD_UPTIME_S = 38, MBD_OVERRUNS_EXEC = 40,
+    MBD_EVICTED = 42, MBD_DROPPED = 44, MBD_EXCHANGE_MAX = 46,
     MBD_BACKEND = 64               /* 64 registers of the I/O backend */
 };
 
@@ -49,7 +60,6 @@ typedef struct mb_item {           /* a program variable from the symbol map */
     unsigned addr, nregs, size;
     int is_bool;
     void *var;                     /* the value in the program */
-    uint8_t shadow[8];
 } mb_item;
 
 typedef struct mb_rec {
@@ -59,19 +69,39 @@ typedef struct mb_rec {
 } mb_rec;
 #define MB_REC_ITEM 0x80000000u
 
-typedef struct mb_shared {
-    pthread_mutex_t lock;
-    plc_image shadow;
+typedef struct mb_batch {          /* writes handed to the scan in one piece */
+    mb_rec rec[MB_LOG_MAX];
+    size_t n;
+    uint64_t seq;                  /* 1, 2, ... in the order handed over */
+} mb_batch;
+
+typedef struct mb_snap {           /* what clients read: one cycle's image */
+    plc_image img;
     uint16_t diag[MB_DIAG_N];
+    uint64_t applied;              /* the last batch landed before it */
+    uint8_t (*items)[8];           /* symbol values */
+} mb_snap;
+
+#define MB_FRESH 4u                /* in mid: the middle snapshot is newer */
+
+typedef struct mb_shared {
     mb_item *items;
     size_t nitems;
-    /* pending writes, one record per element written since the last
-    ** cycle (a later write to the same element replaces the value) */
-    mb_rec log[MB_LOG_MAX];
-    size_t nlog;
-    uint32_t img_idx[sizeof(plc_image)];   /* image offset -> record + 1 */
+    /* image out: the scan owns snap[back], the server snap[front] (its
+    ** view, into which it also writes), mid holds the third */
+    mb_snap snap[3];
+    _Atomic unsigned mid;
+    unsigned back, front;
+    /* writes in: the server fills *fill; *given is the batch handed over
+    ** last, ready while the scan has not landed it */
+    mb_batch batch[2];
+    mb_batch *fill, *given;
+    _Atomic int ready;
+    uint64_t landed;               /* scan's: seq of the last batch landed */
+    uint32_t img_idx[sizeof(plc_image)];   /* server's: image offset -> record + 1 in *fill */
     uint32_t *item_idx;                    /* item -> record + 1 */
-    _Atomic uint64_t requests, exceptions, clients, refused;
+    _Atomic uint64_t requests, exceptions, clients, refused, evicted, dropped;
+    _Atomic uint64_t exchange_max_ns;      /* scan's longest mb_apply + mb_publish */
 } mb_shared;
 
 /* Allocate; items from the config's symbol map resolved against the
@@ -81,10 +111,19 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
 void mb_free(mb_shared *m);
 
 /* Serve one request PDU (function code first); writes the reply PDU into
-** rsp (MB_PDU_MAX bytes) and returns its length. */
+** rsp (MB_PDU_MAX bytes) and returns its length. Server thread. */
 size_t mb_process(mb_shared *m, const uint8_t *pdu, size_t n, uint8_t *rsp);
+/* Take the newest snapshot and hand the pending writes to the scan if it
+** took the last batch in. Server thread; 1 while writes remain pending (call
+** again within a period), else 0. mb_process calls it too. */
+int mb_flush(mb_shared *m);
 
+/* Scan thread: land the batch handed over (start of a cycle); publish the
+** image, the symbols and diag (end of a cycle; diag may be NULL). */
 void mb_apply(mb_shared *m, plc_image *img);
 void mb_publish(mb_shared *m, const plc_image *img, const uint16_t *diag);
+/* Main thread, once the scan and the server stopped: land every write
+** acknowledged to a client (the batch handed over and the one filling). */
+void mb_drain(mb_shared *m, plc_image *img);
 
 #endif

@@ -1,9 +1,13 @@
 /*
-** mbserver.h: the Modbus TCP server. One thread accepts; each client gets
-** its own thread (libmodbus frames the requests, mbmap serves them), so a
-** slow, silent or half-sending client only ever waits on itself. Clients
-** beyond max_clients, or whose descriptor libmodbus's select() could not
-** watch (>= FD_SETSIZE), are closed at once and counted as refused.
+** mbserver.h: the Modbus TCP server. One thread serves every client: it
+** polls non-blocking sockets, frames the requests itself from the MBAP
+** header (the length field says where the next request begins, whatever
+** the function code) and has mbmap serve them. No client can hold it or
+** the scan: a frame must be complete 0.5 s after its first byte, a reply
+** the client does not take within 2 s closes it, a client silent for
+** idle_timeout is closed, and at max_clients the client idle the longest
+** gives way to a new one. A protocol id other than 0, or a length no
+** Modbus TCP frame has, closes the connection.
 */
 #ifndef MBSERVER_H
 #define MBSERVER_H
@@ -15,8 +19,8 @@ typedef struct mb_server mb_server;
 
 /* Listen on the configured address; NULL with a message in err. */
 mb_server *mb_server_start(const plc_config *c, mb_shared *m, char *err, size_t errlen);
-/* Stop accepting, finish the requests being served (their replies are
-** sent), close every client, join the threads. */
+/* Stop serving (a request being served gets its reply first), close every
+** client, join the thread: no write is taken after it returns. */
 void mb_server_stop(mb_server *s);
 
 #endif

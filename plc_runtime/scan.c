@@ -52,6 +52,9 @@ void scan_diag(scan *s, uint16_t *d)
         put32(d, MBD_REFUSED, LD(s->mb->refused));
         put32(d, MBD_REQUESTS, LD(s->mb->requests));
         put32(d, MBD_EXCEPTIONS, LD(s->mb->exceptions));
+        put32(d, MBD_EVICTED, LD(s->mb->evicted));
+        put32(d, MBD_DROPPED, LD(s->mb->dropped));
+        put32(d, MBD_EXCHANGE_MAX, LD(s->mb->exchange_max_ns) / 1000);
     }
     put32(d, MBD_RETAIN_SAVES, LD(s->retain_saves));
     put32(d, MBD_RETAIN_ERRORS, LD(s->retain_errors));
@@ -102,7 +105,11 @@ __attribute__((noinline)) void scan_cycle(scan *s, uint64_t plc_ns, unsigned lon
     uint16_t diag[MB_DIAG_N];
     if (s->io->read_inputs(s->io_state, &plc_img, plc_ns))
         atomic_fetch_add_explicit(&s->stats.io_errors, 1, memory_order_relaxed);
-    if (s->mb) mb_apply(s->mb, &plc_img);
+    uint64_t x0 = s->mb ? scan_now_ns() : 0, x1 = 0;
+    if (s->mb) {
+        mb_apply(s->mb, &plc_img);
+        x1 = scan_now_ns();
+    }
     uint64_t ns = (uint64_t)s->base_nsec + plc_ns % 1000000000u;
     p->now->tv_sec = s->base_sec + (long)(plc_ns / 1000000000u) + (long)(ns / 1000000000u);
     p->now->tv_nsec = (long)(ns % 1000000000u);
@@ -110,7 +117,12 @@ __attribute__((noinline)) void scan_cycle(scan *s, uint64_t plc_ns, unsigned lon
     take_samples(s);
     if (s->mb) {
         scan_diag(s, diag);
+        uint64_t x2 = scan_now_ns();
         mb_publish(s->mb, &plc_img, diag);
+        /* the exchange's cost: landing the writes plus publishing */
+        uint64_t x = x1 - x0 + scan_now_ns() - x2;
+        if (x > LD(s->mb->exchange_max_ns))
+            atomic_store_explicit(&s->mb->exchange_max_ns, x, memory_order_relaxed);
     }
     if (s->io->write_outputs(s->io_state, &plc_img))
         atomic_fetch_add_explicit(&s->stats.io_errors, 1, memory_order_relaxed);

@@ -1,7 +1,9 @@
 /*
 ** scan.h: the real-time scan thread. Each period (absolute
 ** clock_nanosleep on CLOCK_MONOTONIC): read inputs -> apply Modbus writes
-** -> run the program -> publish to Modbus -> write outputs. A cycle that
+** -> run the program -> publish to Modbus -> write outputs. The Modbus
+** steps take and give whole buffers (mbmap.h): no lock, no waiting, no
+** allocation; their longest cost is kept for the diagnostics. A cycle that
 ** ends past the next period boundary is an overrun: counted, and the next
 ** cycle starts on the first boundary still ahead (never a burst).
 */

@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
-"""plcrt benchmarks: wake latency beside cyclictest, Modbus throughput under
-libmodbus's bandwidth-client, and the runtime's own cost per cycle.
+"""plcrt benchmarks: wake latency beside cyclictest, Modbus throughput beside
+a reference server on libmodbus's modbus_reply (bench/runtime/refserver.c)
+under the same load (bench/runtime/mbload.c), and the runtime's own cost per
+cycle.
 
-usage: bench.py PLCRT_1MS PLCRT_250US BANDWIDTH_CLIENT PORT|auto WORKDIR
-(auto: a port free now, passed to bandwidth-client in MODBUS_PORT)"""
+usage: bench.py PLCRT_1MS PLCRT_250US PORT|auto WORKDIR REFSERVER MBLOAD
+(auto: a port free now). BENCH_ONLY=modbus runs the Modbus part alone."""
 import os
 import re
 import signal
+import statistics
 import socket
 import subprocess
 import sys
@@ -18,9 +21,8 @@ def free_port():
         return s.getsockname()[1]
 
 
-P1, P250, BW, WORK = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[5]
-PORT = free_port() if sys.argv[4] == "auto" else int(sys.argv[4])
-os.environ["MODBUS_PORT"] = str(PORT)
+P1, P250, WORK, REF, LOAD = sys.argv[1], sys.argv[2], sys.argv[4], sys.argv[5], sys.argv[6]
+PORT = free_port() if sys.argv[3] == "auto" else int(sys.argv[3])
 SECONDS = int(os.environ.get("BENCH_SECONDS", "10"))
 os.makedirs(WORK, exist_ok=True)
 
@@ -63,6 +65,10 @@ def plcrt_stats(text):
     out = {}
     m = re.search(r"statistics: (\d+) cycles of [\d.]+ us, (\d+) overruns", text)
     out["cycles"], out["overruns"] = int(m.group(1)), int(m.group(2))
+    m = re.search(r"overruns: (\d+) with the program's execution alone over the period", text)
+    out["own"] = int(m.group(1)) if m else 0
+    m = re.search(r"^exchange (-?\d+)$", text, re.M)
+    out["exchange"] = int(m.group(1)) if m else None
     for key, name in (("lat", "wake latency"), ("exec", "execution")):
         m = re.search(name + r"\s+min\s+([\d.]+)\s+mean\s+([\d.]+)\s+p99\s+([\d.]+)\s+p99.9\s+([\d.]+)\s+max\s+([\d.]+)", text)
         out[key] = dict(zip(("min", "mean", "p99", "p999", "max"), map(float, m.groups())))
@@ -112,23 +118,73 @@ def latency(binary, period_us):
     return st
 
 
-def modbus():
-    print(f"\nModbus TCP, FC 3 of 125 registers (libmodbus bandwidth-client), scanning every 1 ms:")
-    for n in (1, 4, 16):
-        p = start(P1, ini(modbus=True))
+def load(clients, seconds):
+    r = subprocess.run([LOAD, str(PORT), str(clients), str(seconds)], capture_output=True, text=True, timeout=60)
+    m = re.match(r"(\d+) requests/s", r.stdout)
+    if r.returncode or not m:
+        raise RuntimeError(f"mbload: {r.stdout} {r.stderr}")
+    return int(m.group(1))
+
+
+def exchange_us():
+    """Register 1070: the scan's longest Modbus exchange (docs/modbus.md)."""
+    with socket.create_connection(("127.0.0.1", PORT), timeout=3) as s:
+        s.sendall(bytes([0, 1, 0, 0, 0, 6, 1, 4, 1070 >> 8, 1070 & 255, 0, 2]))
+        r = b""
+        while len(r) < 13:
+            got = s.recv(13 - len(r))
+            if not got:
+                return -1
+            r += got
+    return int.from_bytes(r[9:13], "big")
+
+
+def plcrt_round(clients, seconds):
+    p = start(P1, ini(modbus=True))
+    wait_port()
+    rate = load(clients, seconds)
+    st = plcrt_stats(stop_after(p, exchange_us()))
+    return rate, st
+
+
+def stop_after(p, xch):
+    text = stop(p)
+    return text + f"\nexchange {xch}\n"
+
+
+def ref_round(clients, seconds):
+    q = subprocess.Popen([REF, str(PORT)], stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
+    try:
         wait_port()
-        t0 = time.time()
-        clients = [subprocess.Popen([BW], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True) for _ in range(n)]
-        outs = [c.communicate()[0] for c in clients]
-        wall = time.time() - t0
-        st = plcrt_stats(stop(p))
-        rates = []
-        for o in outs:
-            m = re.search(r"READ REGISTERS\s+Transfert rate in points/seconds:\s+\* (\d+) registers/s", o)
-            rates.append(int(m.group(1)) / 125 if m else 0)
-        print(f"  {n:2d} client(s): {sum(rates):9.0f} requests/s in total ({min(rates):7.0f}..{max(rates):7.0f} per client), "
-              f"{st['overruns']} overruns in {st['cycles']} cycles, worst execution {st['exec']['max']:.1f} us, "
-              f"worst wake latency {st['lat']['max']:.1f} us ({wall:.1f} s)")
+        return load(clients, seconds)
+    finally:
+        q.terminate()
+        q.wait()
+
+
+def modbus():
+    rounds, seconds = 3, float(os.environ.get("BENCH_MB_SECONDS", "3"))
+    print(f"\nModbus TCP, FC 3 of 125 registers back to back (mbload), {rounds} rounds of {seconds:g} s; "
+          f"plcrt scanning an empty program every 1 ms at SCHED_FIFO 80 beside the reference server "
+          f"(libmodbus's modbus_reply, select(), nothing else); requests/s in total, medians:")
+    for n in (1, 4, 16):
+        plc, ref, worst, over, xch = [], [], [], [], []
+        for r in range(rounds):
+            order = (0, 1) if r % 2 == 0 else (1, 0)       # neither always goes first
+            for which in order:
+                if which == 0:
+                    rate, st = plcrt_round(n, seconds)
+                    plc.append(rate)
+                    worst.append(st["exec"]["max"])
+                    xch.append(st["exchange"])
+                    over.append(f"{st['overruns']}/{st['own']}")
+                else:
+                    ref.append(ref_round(n, seconds))
+        mp, mr = statistics.median(plc), statistics.median(ref)
+        print(f"  {n:2d} client(s): plcrt {mp:8.0f}  reference {mr:8.0f}  ratio plcrt/reference {mp / mr:5.2f}  "
+              f"(rounds plcrt {plc}, reference {ref}); scan: longest execution {max(worst):.1f} us "
+              f"(rounds {worst}), of which the Modbus exchange at most {max(xch)} us (rounds {xch}), "
+              f"overruns in all/of its own {over}")
 
 
 def cost(st_mb):
@@ -152,6 +208,9 @@ def cost(st_mb):
 
 
 def main():
+    if os.environ.get("BENCH_ONLY") == "modbus":
+        modbus()
+        return
     st1 = latency(P1, 1000)
     latency(P250, 250)
     modbus()

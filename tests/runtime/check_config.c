@@ -38,6 +38,7 @@ START_TEST(defaults)
     ck_assert_str_eq(c.mb_bind, "127.0.0.1");
     ck_assert_int_eq(c.mb_port, 1502);
     ck_assert_int_eq(c.mb_max_clients, 16);
+    ck_assert_int_eq(c.mb_idle_timeout, 10);    /* issue: silent clients held slots 60 s */
     ck_assert_str_eq(c.backend, "sim");
     ck_assert_int_eq(c.priority, 80);
     ck_assert_int_eq(c.retain_period, 10);

@@ -1,9 +1,11 @@
 /* The Modbus map at every boundary, exceptions, atomic writes, symbol map.
 ** Expected register values are worked out by hand from docs/modbus.md. */
 #include <check.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "config.h"
 #include "mbmap.h"
 #include "../common/check_run.h"
@@ -87,7 +89,9 @@ static void write_coils(unsigned a, unsigned n, const uint8_t *bits)
 #define EXC(fc, code) do { ck_assert_uint_eq(rn, 2); ck_assert_uint_eq(rsp[0], (fc) | 0x80); ck_assert_uint_eq(rsp[1], code); } while (0)
 #define OK(fc) do { ck_assert_msg(rsp[0] == (fc), "exception %u", rsp[1]); } while (0)
 static unsigned reg(int i) { return (unsigned)rsp[2 + 2 * i] << 8 | rsp[3 + 2 * i]; }
-static void cycle(void) { mb_apply(m, &img); mb_publish(m, &img, NULL); }
+/* The server's turn (take the newest snapshot, hand writes over), then a
+** cycle's start and end. */
+static void cycle(void) { mb_flush(m); mb_apply(m, &img); mb_publish(m, &img, NULL); }
 
 START_TEST(coils_edges)
 {
@@ -282,6 +286,9 @@ START_TEST(many_writes_between_cycles)
     uint8_t bits[1968];
     for (int i = 0; i < 1968; i++) bits[i] = (uint8_t)(i & 1);
     for (unsigned a = 0; a < 8192 - 1968; a += 1968) { write_coils(a, 1968, bits); OK(15); }
+    /* the first write went to the scan at once; all the others, one
+    ** element each, in the next batch: two cycles land everything */
+    cycle();
     cycle();
     /* the last write at 0 (%QW0..122) was i = 1992: register k = 1992 + k */
     ck_assert_int_eq(img_get16(img.qw, 0), 1992);
@@ -290,6 +297,46 @@ START_TEST(many_writes_between_cycles)
     ck_assert(img_get64(img.ml, 226) == (int64_t)((1997ULL << 48) | (1998ULL << 32) | (1999ULL << 16) | 2000ULL));
     ck_assert_uint_eq(img.qx[1], 1);
     ck_assert_uint_eq(img.qx[2], 0);
+}
+END_TEST
+
+/* A scan on its own thread, cycling as fast as it can: the program's view
+** of %MD100 must always be one whole value a client wrote. */
+#define VAL_A 0x11112222u
+#define VAL_B 0x33334444u
+static _Atomic int scan_stop;
+static int torn_in_program;
+
+static void *scan_loop(void *arg)
+{
+    (void)arg;
+    while (!atomic_load(&scan_stop)) {
+        mb_apply(m, &img);
+        uint32_t v = (uint32_t)img_get32(img.md, 100);
+        if (v && v != VAL_A && v != VAL_B) torn_in_program++;
+        mb_publish(m, &img, NULL);
+    }
+    return NULL;
+}
+
+START_TEST(threads_never_tear)
+{
+    pthread_t th;
+    atomic_store(&scan_stop, 0);
+    torn_in_program = 0;
+    ck_assert_int_eq(pthread_create(&th, NULL, scan_loop, NULL), 0);
+    for (int i = 0; i < 20000; i++) {
+        uint32_t v = i % 2 ? VAL_B : VAL_A;
+        uint16_t w[2] = { (uint16_t)(v >> 16), (uint16_t)v };
+        write_regs(2048 + 200, 2, w); OK(16);                  /* %MD100 */
+        req(3, 2048 + 200, 2); OK(3);
+        ck_assert_uint_eq((uint32_t)reg(0) << 16 | reg(1), v); /* its own write, whole */
+    }
+    for (int k = 0; k < 10000 && mb_flush(m); k++) usleep(100);   /* the last batch lands */
+    atomic_store(&scan_stop, 1);
+    pthread_join(th, NULL);
+    ck_assert_int_eq(torn_in_program, 0);
+    ck_assert_uint_eq((uint32_t)img_get32(img.md, 100), VAL_B);   /* i = 19999 wrote B */
 }
 END_TEST
 
@@ -332,6 +379,7 @@ int main(void)
     tcase_add_test(t, fc23);
     tcase_add_test(t, symbols);
     tcase_add_test(t, many_writes_between_cycles);
+    tcase_add_test(t, threads_never_tear);
     tcase_add_test(t, symbol_errors);
     suite_add_tcase(s, t);
     return check_run(s);

@@ -8,6 +8,7 @@ it from MODBUS_PORT)
 Prints PASS:/FAIL: lines; exits 1 if anything failed."""
 import os
 import re
+import select
 import signal
 import socket
 import struct
@@ -19,7 +20,7 @@ import time
 from pymodbus.client import ModbusTcpClient
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Plcrt, free_port  # noqa: E402
+from peer import Plcrt, free_port, wait_for  # noqa: E402
 
 PLCRT, RANDOM_CLIENT, WORK = sys.argv[1], sys.argv[2], sys.argv[4]
 PORT = free_port() if sys.argv[3] == "auto" else int(sys.argv[3])
@@ -224,33 +225,50 @@ def test_half_frame_and_silent():
 
 def test_flood():
     c = client()
-    refused0 = diag(c, 26)
-    socks = []
-    for _ in range(40):
-        socks.append(socket.create_connection(("127.0.0.1", PORT)))
-    closed = 0
-    for s in socks:
+    evicted0 = diag(c, 42)
+    c.close()
+    time.sleep(0.1)
+    socks = [socket.create_connection(("127.0.0.1", PORT)) for _ in range(40)]
+
+    def closed():
+        """Indexes of the sockets the server closed (readable at end of file)."""
+        r, _, _ = select.select(socks, [], [], 0)
+
+        def at_eof(s):
+            try:
+                return s.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
+            except OSError:
+                return True
+        return sorted(i for i, s in enumerate(socks) if s in r and at_eof(s))
+    # each connection past the 16th pushes the longest idle out; wait for all
+    # of them to be accepted before sending anything (a request makes a
+    # client the most recently active)
+    gone = wait_for(lambda: len(closed()) >= 24 and closed(), 3, 0.05) or closed()
+    served = []
+    for i, s in enumerate(socks):
         s.settimeout(2)
         try:
             s.sendall(bytes([0, 9, 0, 0, 0, 6, 1, 3, 0, 0, 0, 1]))
-            if s.recv(100) == b"":
-                closed += 1
+            if len(s.recv(100)) == 11:
+                served.append(i)
         except OSError:
-            closed += 1
-    # 16 slots, one held by c
-    report("connections past the cap are closed at once", closed == 40 - 15, f"{closed} closed")
+            pass
+    # max_clients = 16: the 16 newest stay, the 24 before them gave way
+    report("a flood of connections: the 16 newest are served, the older ones gave way",
+           gone == list(range(24)) and served == list(range(24, 40)), f"closed {gone}, served {served}")
+    c = client()                         # one more: the longest idle gives way again
     ok = not c.read_holding_registers(0, 1, slave=1).isError()
-    report("the client inside the cap is still served", ok)
+    report("a new client is admitted while the cap is full", ok)
     time.sleep(0.1)                      # diagnostics are published once per cycle
-    refused = diag(c, 26) - refused0
-    report("refused connections are counted", refused == 25, f"refused {refused}")
+    evicted = diag(c, 42) - evicted0
+    report("clients that gave way are counted (register 1066)", evicted == 25, f"evicted {evicted}")
     for s in socks:
         s.close()
-    time.sleep(0.5)
+    c.close()
+    time.sleep(0.3)
     errors = []
     worker(1, 20, errors)
     report("after the flood, new clients are served", not errors, "; ".join(errors))
-    c.close()
 
 
 def test_sigusr1(p):

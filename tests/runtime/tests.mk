@@ -77,3 +77,11 @@ test-runtime-config: $(BUILD)/plc/rt_iotest/plcrt
 	@mk/suite.sh $(RESULTS) runtime-config python3 tests/runtime/test_config.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(abspath $(RT_T))/config
 TESTS += test-runtime-config
+# the Modbus server against misbehaving clients, and the 1 ms scan under a
+# flood of them
+$(eval $(call plcrt_program,rt_fast,tests/runtime/st/fast.st))
+.PHONY: test-runtime-mbserver
+test-runtime-mbserver: $(BUILD)/plc/rt_iotest/plcrt $(BUILD)/plc/rt_fast/plcrt
+	@mk/suite.sh $(RESULTS) runtime-mbserver python3 tests/runtime/test_mbserver.py \
+	  $(BUILD)/plc/rt_iotest/plcrt $(BUILD)/plc/rt_fast/plcrt $(abspath $(RT_T))/mbserver
+TESTS += test-runtime-mbserver
