@@ -4,6 +4,7 @@
 APOSSCTL_TESTS := $(wildcard tests/apossctl/t_*.st)
 
 TESTS += test-apossctl
+MATIEC_TESTS += test-apossctl
 
 .PHONY: test-apossctl
 test-apossctl: $(ST_LIB) $(STC)
