@@ -14,3 +14,4 @@ test-examples: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/multiaxis/plcrt $(BUILD)/
 	$(call EX_RUN,preset) || rc=1; \
 	exit $$rc
 TESTS += test-examples
+MATIEC_TESTS += test-examples

@@ -49,6 +49,7 @@ test-runtime-image: $(RT_T)/check_image $(RT_T)/check_sim_block $(STC)
 	mk/suite.sh $(RESULTS) runtime-located-outside tests/runtime/located_outside.sh \
 	  $(STC) $(STC_INC) $(RT_T)/outside $(CC) $(PLC_GEN_CFLAGS) || rc=1; exit $$rc
 TESTS += test-runtime-image
+MATIEC_TESTS += test-runtime-image
 
 # integration: libmodbus's own random-test-client, pointed at the port the
 # test picks (free at run time, so that several runs may share a machine)
@@ -63,6 +64,7 @@ test-runtime-integration: $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-clien
 	@mk/suite.sh $(RESULTS) runtime-integration python3 tests/runtime/test_plcrt.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client auto $(abspath $(RT_T))/integration
 TESTS += test-runtime-integration
+MATIEC_TESTS += test-runtime-integration
 # overruns: a program made too slow over Modbus, counted as its own
 $(eval $(call plcrt_program,rt_spin,tests/runtime/st/spin.st))
 .PHONY: test-runtime-overrun
@@ -85,3 +87,11 @@ test-runtime-mbserver: $(BUILD)/plc/rt_iotest/plcrt $(BUILD)/plc/rt_fast/plcrt
 	@mk/suite.sh $(RESULTS) runtime-mbserver python3 tests/runtime/test_mbserver.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(BUILD)/plc/rt_fast/plcrt $(abspath $(RT_T))/mbserver
 TESTS += test-runtime-mbserver
+# program instances named p, axis and res0: matiec's instance macros stay in
+# its resource file
+$(eval $(call plcrt_program,rt_names,tests/runtime/st/names.st))
+.PHONY: test-runtime-names
+test-runtime-names: $(BUILD)/plc/rt_names/plcrt
+	@mk/suite.sh $(RESULTS) runtime-names tests/runtime/names.sh $< $(RT_T)/names
+TESTS += test-runtime-names
+MATIEC_TESTS += test-runtime-names
