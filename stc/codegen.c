@@ -907,6 +907,41 @@ static int64_t gcd64(int64_t a, int64_t b) { while (b) { int64_t t = a % b; a = 
 /* VARIABLES.csv rows: one per variable, an FB instance followed by its own. */
 static void csv_vars(Buf *b, int *num, Pou *p, const char *path, bool retain);
 
+/* The elementary parts of an array or a structure, one row each: the IEC
+** path with the indexes as written (TAB[2,3], CFG.LIMITS.MAX), the C path
+** to the element (TAB.table[k]). Arrays of function blocks are left out;
+** at most CSV_MAX_PARTS rows per variable. */
+enum { CSV_MAX_PARTS = 65536 };
+
+static void csv_parts(Buf *b, int *num, Type *t, const char *iec, const char *cp, bool r, int *budget) {
+    Type *c = ct(t);
+    if (*budget <= 0) return;
+    if (c->kind == T_ARRAY) {
+        for (int64_t k = 0; k < c->count && *budget > 0; k++) {
+            Buf ix = {0};
+            int64_t rest = k, size = c->count;
+            for (int d = 0; d < c->ndims; d++) {
+                int64_t n = c->dims[d].hi - c->dims[d].lo + 1;
+                size /= n;
+                buf_printf(&ix, "%s%lld", d ? "," : "", (long long)(c->dims[d].lo + rest / size));
+                rest %= size;
+            }
+            csv_parts(b, num, c->elem, fmt("%s[%s]", iec, ix.s), fmt("%s.table[%lld]", cp, (long long)k), r, budget);
+        }
+        return;
+    }
+    if (c->kind == T_STRUCT) {
+        for (int i = 0; i < c->fields.n && *budget > 0; i++) {
+            Field *f = c->fields.v[i];
+            csv_parts(b, num, f->type, fmt("%s.%s", iec, f->uname), fmt("%s.%s", cp, f->uname), r, budget);
+        }
+        return;
+    }
+    if (c->kind == T_FB) return;
+    (*budget)--;
+    buf_printf(b, "%d;VAR;%s;%s;%s;%s;%d;\n", (*num)++, iec, cp, t->name, t->name, r);
+}
+
 static void csv_var(Buf *b, int *num, Sym *s, const char *vp, bool r) {
     Type *c = ct(s->type);
     if (c->kind == T_FB && !s->pointer) {
@@ -914,7 +949,14 @@ static void csv_var(Buf *b, int *num, Sym *s, const char *vp, bool r) {
         csv_vars(b, num, c->pou, vp, r);
         return;
     }
-    if (c->kind == T_ARRAY || c->kind == T_STRUCT || c->kind == T_FB) return;   /* as matiec */
+    if (c->kind == T_FB) return;
+    if (c->kind == T_ARRAY || c->kind == T_STRUCT) {
+        /* matiec lists no arrays or structures; stc lists their elementary
+        ** parts, so that they can be retained and mapped to Modbus */
+        int budget = CSV_MAX_PARTS;
+        if (!s->pointer) csv_parts(b, num, s->type, vp, vp, r, &budget);
+        return;
+    }
     const char *kind = "VAR";
     if (s->cls == V_EXTERNAL) kind = "EXT";
     else if (s->decl && s->decl->location)

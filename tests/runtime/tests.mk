@@ -95,3 +95,9 @@ test-runtime-names: $(BUILD)/plc/rt_names/plcrt
 	@mk/suite.sh $(RESULTS) runtime-names tests/runtime/names.sh $< $(RT_T)/names
 TESTS += test-runtime-names
 MATIEC_TESTS += test-runtime-names
+# arrays, structures and block instances: retained, and exposed by IEC path
+$(eval $(call plcrt_program,rt_aggregates,tests/runtime/st/aggregates.st))
+.PHONY: test-runtime-aggregates
+test-runtime-aggregates: $(BUILD)/plc/rt_aggregates/plcrt
+	@mk/suite.sh $(RESULTS) runtime-aggregates python3 tests/runtime/test_aggregates.py $< $(abspath $(RT_T))/aggregates
+TESTS += test-runtime-aggregates
