@@ -21,6 +21,11 @@ static Token *next(P *p) { Token *t = cur(p); if (t->kind != TK_EOF) p->i++; ret
 
 static bool is_kw(Token *t, const char *kw) { return t->kind == TK_IDENT && !strcmp(t->up, kw); }
 static bool is_p(Token *t, const char *s) { return t->kind == TK_PUNCT && !strcmp(t->up, s); }
+/* A keyword beginning with prefix (END_..., VAR_...): a name that merely
+   starts the same way, like var_out or end_x, is an identifier. */
+static bool kw_prefix(Token *t, const char *prefix) {
+    return t->kind == TK_IDENT && !strncmp(t->up, prefix, strlen(prefix)) && is_reserved(t->up);
+}
 
 static const char *desc(Token *t) {
     if (t->kind == TK_EOF) return "end of file";
@@ -50,11 +55,11 @@ static Token *expect_kw(P *p, const char *kw) {
 static void expect_end(P *p, Token *open, const char *what, const char *end) {
     if (accept_kw(p, end)) return;
     Token *t = cur(p);
-    if (t->kind == TK_EOF || (t->kind == TK_IDENT && (!strncmp(t->up, "END_", 4) ||
+    if (t->kind == TK_EOF || (t->kind == TK_IDENT && (kw_prefix(t, "END_") ||
         !strcmp(t->up, "FUNCTION") || !strcmp(t->up, "FUNCTION_BLOCK") || !strcmp(t->up, "PROGRAM") ||
         !strcmp(t->up, "CONFIGURATION") || !strcmp(t->up, "TYPE") || !strcmp(t->up, "ELSE") ||
         !strcmp(t->up, "ELSIF") || !strcmp(t->up, "UNTIL") || !strcmp(t->up, "VAR") ||
-        !strncmp(t->up, "VAR_", 4) || !strcmp(t->up, "RESOURCE"))))
+        kw_prefix(t, "VAR_") || !strcmp(t->up, "RESOURCE"))))
         fatal_at(open->loc, "%s without %s", what, end);
     expected(p, fmt("'%s'", end));
 }
@@ -475,7 +480,7 @@ static void var_decls(P *p, Vec *out, VarClass cls, bool constant, bool retain, 
         Token *t = cur(p);
         if (t->kind != TK_IDENT || is_reserved(t->up)) {
             if (is_kw(t, end)) return;
-            if (t->kind == TK_IDENT && (!strncmp(t->up, "END_", 4) || !strncmp(t->up, "VAR", 3) ||
+            if (t->kind == TK_IDENT && (kw_prefix(t, "END_") || !strncmp(t->up, "VAR", 3) ||
                                         is_kw(t, "FUNCTION") || is_kw(t, "FUNCTION_BLOCK") ||
                                         is_kw(t, "PROGRAM")))
                 return;   /* caller reports the missing END_VAR */
@@ -725,9 +730,9 @@ static bool stmt_stop(P *p) {
     Token *t = cur(p);
     if (t->kind == TK_EOF) return true;
     if (t->kind != TK_IDENT) return false;
-    return !strncmp(t->up, "END_", 4) || is_kw(t, "ELSE") || is_kw(t, "ELSIF") || is_kw(t, "UNTIL") ||
+    return kw_prefix(t, "END_") || is_kw(t, "ELSE") || is_kw(t, "ELSIF") || is_kw(t, "UNTIL") ||
            is_kw(t, "FUNCTION") || is_kw(t, "FUNCTION_BLOCK") || is_kw(t, "PROGRAM") ||
-           is_kw(t, "CONFIGURATION") || is_kw(t, "TYPE") || is_kw(t, "VAR") || !strncmp(t->up, "VAR_", 4);
+           is_kw(t, "CONFIGURATION") || is_kw(t, "TYPE") || is_kw(t, "VAR") || kw_prefix(t, "VAR_");
 }
 
 static void stmts(P *p, Vec *out, bool in_case) {
