@@ -209,7 +209,9 @@ static Node *primary(P *p) {
             }
             return n;
         }
-        if (is_reserved(t->up)) {
+        bool opfn = (is_kw(t, "AND") || is_kw(t, "OR") || is_kw(t, "XOR") || is_kw(t, "NOT") || is_kw(t, "MOD")) &&
+                    is_p(peek(p, 1), "(");   /* the operator functions AND(a, b), ... */
+        if (is_reserved(t->up) && !opfn) {
             /* type-named conversion calls like INT_TO_REAL are not reserved; these are */
             fatal_at(t->loc, "expected expression, found keyword '%s'", t->text);
         }
@@ -262,7 +264,8 @@ static Node *unary(P *p) {
         if (!strcmp(n->op, "+")) { n->lhs->start = t->loc; return n->lhs; }
         return n;
     }
-    if (is_kw(t, "NOT")) {
+    /* NOT(IN := x) is the function; NOT (x) the operator, with the same meaning */
+    if (is_kw(t, "NOT") && !(is_p(peek(p, 1), "(") && peek(p, 2)->kind == TK_IDENT && is_p(peek(p, 3), ":="))) {
         next(p);
         enter(p);
         Node *n = new_node(N_UNARY, t);

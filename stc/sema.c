@@ -391,6 +391,11 @@ static bool lit_fits(Node *n, Type *t, bool report) {
         return true;
     }
     case N_CALL:
+        if (n->opx) {
+            if (!lit_fits(n->opx, t, report)) return false;
+            n->ty = t;
+            return true;
+        }
         for (int i = 0; i < n->list.n; i++) {
             Node *a = n->list.v[i];
             if (a->lhs && is_lit(a->lhs->ty) && !lit_fits(a->lhs, t, report)) return false;
@@ -443,9 +448,48 @@ static Type *check(Ctx *c, Node *n, Type *want);
 static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb);
 static Type *check_builtin(Ctx *c, Node *n, Type *want);
 
+/* EN and ENO of a function or function block (IEC 61131-3 2.5.1.2): every one
+   has them, so they appear when a call or the body first names them, as a
+   BOOL input EN (initially TRUE) and a BOOL output ENO. */
+static bool is_en_eno(const char *uname) { return !strcmp(uname, "EN") || !strcmp(uname, "ENO"); }
+
+static Sym *implicit_flag(Pou *p, char *name, VarClass cls) {
+    Sym *s = new_sym(SK_VAR, name, name, p->loc);
+    VarDecl *d = xalloc(sizeof *d);
+    d->name = d->uname = name;
+    d->loc = p->loc;
+    d->cls = cls;
+    if (cls == V_INPUT) {
+        Node *t = xalloc(sizeof *t);
+        t->kind = N_BOOL;
+        t->ival = 1;
+        t->ty = ty_prim[T_BOOL];
+        t->loc = t->start = p->loc;
+        d->init = t;
+    }
+    s->decl = d;
+    s->cls = cls;
+    s->type = ty_prim[T_BOOL];
+    s->pou = p;
+    s->in_function = p->kind == POU_FUNCTION;
+    s->implicit = true;
+    vec_push(&p->syms, s);
+    return s;
+}
+
+static void need_en_eno(Pou *p) {
+    if (p->kind == POU_PROGRAM) return;
+    if (!p->en) p->en = implicit_flag(p, "EN", V_INPUT);
+    if (!p->eno) p->eno = implicit_flag(p, "ENO", V_OUTPUT);
+}
+
 static Sym *lookup_var(Ctx *c, const char *uname) {
     Sym *s = find(c->scope, uname);
     if (s) return s;
+    if (c->pou && c->pou->kind != POU_PROGRAM && is_en_eno(uname)) {
+        need_en_eno(c->pou);
+        return find(c->scope, uname);
+    }
     if (!c->pou) {
         if ((s = find(c->gscope[0], uname))) return s;
         if ((s = find(c->gscope[1], uname))) return s;
@@ -538,7 +582,12 @@ static Type *check_member(Ctx *c, Node *n) {
         }
     } else if (t->kind == T_FB) {
         Sym *m = find(&t->pou->syms, n->uname);
-        if (m && (m->cls == V_INPUT || m->cls == V_OUTPUT)) { n->sym = m; return m->type; }
+        if (!m && is_en_eno(n->uname) && t->pou->kind == POU_FB) {
+            need_en_eno(t->pou);
+            m = find(&t->pou->syms, n->uname);
+        }
+        /* an in-out reads the variable the last call connected */
+        if (m && (m->cls == V_INPUT || m->cls == V_OUTPUT || m->cls == V_IN_OUT)) { n->sym = m; return m->type; }
         if (m) {
             error_at(n->loc, "'%s' is an internal variable of '%s', not accessible from outside", n->name, t->pou->name);
             return err_type();
@@ -596,8 +645,11 @@ static OpClass op_class(const char *op) {
     return OP_CMP;
 }
 
+/* the operator as the user wrote it: '+' or ADD */
+static const char *opname(Node *n) { return n->name ? n->name : n->op; }
+
 static Type *mismatch(Node *n, Type *a, Type *b) {
-    error_at(n->loc, "type mismatch: %s and %s in '%s'", type_name(a), type_name(b), n->op);
+    error_at(n->loc, "type mismatch: %s and %s in '%s'", type_name(a), type_name(b), opname(n));
     return err_type();
 }
 
@@ -677,7 +729,7 @@ static Type *check_binary(Ctx *c, Node *n, Type *want) {
     Type *ct = canon(t);
     switch (k) {
     case OP_ARITH:
-        if (!is_num(ct)) { error_at(n->loc, "'%s' is not defined for %s", n->op, t->name); return err_type(); }
+        if (!is_num(ct)) { error_at(n->loc, "'%s' is not defined for %s", opname(n), t->name); return err_type(); }
         return t;
     case OP_MOD:
         if (!is_int(ct)) { error_at(n->loc, "'MOD' needs integers, not %s", t->name); return err_type(); }
@@ -685,21 +737,21 @@ static Type *check_binary(Ctx *c, Node *n, Type *want) {
     case OP_LOGIC:
         if (ct->kind != T_BOOL && !is_bit(ct)) {
             if (is_lit(ct) && wop == NULL) { default_lit(n->lhs); default_lit(n->rhs); }
-            error_at(n->loc, "'%s' needs BOOL or bit strings, not %s", n->op, t->name);
+            error_at(n->loc, "'%s' needs BOOL or bit strings, not %s", opname(n), t->name);
             return err_type();
         }
         return t;
     case OP_CMP:
         if (is_lit(ct)) { default_lit(n->lhs); default_lit(n->rhs); ct = canon(n->lhs->ty); }
         if (!is_num(ct) && !is_bit(ct) && !is_timeish(ct) && ct->kind != T_STRING && ct->kind != T_BOOL) {
-            error_at(n->loc, "'%s' cannot compare %s", n->op, t->name);
+            error_at(n->loc, "'%s' cannot compare %s", opname(n), t->name);
             return err_type();
         }
         return ty_prim[T_BOOL];
     case OP_EQ:
         if (is_lit(ct)) { default_lit(n->lhs); default_lit(n->rhs); ct = canon(n->lhs->ty); }
         if (!is_elementary(ct) && ct->kind != T_ENUM) {
-            error_at(n->loc, "'%s' cannot compare %s", n->op, t->name);
+            error_at(n->loc, "'%s' cannot compare %s", opname(n), t->name);
             return err_type();
         }
         return ty_prim[T_BOOL];
@@ -745,6 +797,12 @@ static void check_writable(Ctx *c, Node *n) {
     if (r->loop_locked) { error_at(n->start, "cannot assign to FOR variable '%s' inside its loop", r->name); return; }
     /* writing an instance's member from outside: inputs only */
     for (Node *m = n; m->kind == N_MEMBER || m->kind == N_INDEX; m = m->lhs) {
+        if (m->kind == N_MEMBER && m->sym && m->sym->kind == SK_VAR && m->sym->cls == V_IN_OUT) {
+            Node *inst = m->lhs;
+            error_at(n->start, "cannot assign to in-out '%s' of instance '%s': connect it in a call", m->name,
+                     inst->kind == N_IDENT ? inst->name : "instance");
+            return;
+        }
         if (m->kind == N_MEMBER && m->sym && m->sym->kind == SK_VAR && m->sym->cls == V_OUTPUT) {
             Node *inst = m->lhs;
             const char *iname = inst->kind == N_IDENT ? inst->name : "instance";
@@ -755,6 +813,14 @@ static void check_writable(Ctx *c, Node *n) {
     if (c->pou && c->pou->kind == POU_FUNCTION && r->cls == V_INPUT && n->kind == N_IDENT) return;
 }
 
+/* A call naming EN or ENO gives the callee both. */
+static void uses_en_eno(Node *call, Pou *p) {
+    for (int i = 0; i < call->list.n; i++) {
+        Node *a = call->list.v[i];
+        if (a->uname && is_en_eno(a->uname)) need_en_eno(p);
+    }
+}
+
 static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
     if (n->lhs) {      /* a[i](...): the instance is an expression */
         Type *it = check(c, n->lhs, NULL);
@@ -762,6 +828,7 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
         if (canon(it)->kind != T_FB) { error_at(n->lhs->start, "this is not a function block instance, it is %s", type_name(it)); return err_type(); }
         n->callee = canon(it)->pou;
         n->name = n->callee->name;
+        uses_en_eno(n, n->callee);
         check_call_args(c, n, n->callee, true);
         return ty_prim[T_VOID];
     }
@@ -778,6 +845,7 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
         }
         n->sym = v;
         n->callee = t->pou;
+        uses_en_eno(n, t->pou);
         check_call_args(c, n, t->pou, true);
         return ty_prim[T_VOID];
     }
@@ -791,6 +859,7 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
         p->pou->used = true;
         n->callee = p->pou;
         if (c->pou) vec_push(&c->pou->calls, p->pou);
+        uses_en_eno(n, p->pou);
         check_call_args(c, n, p->pou, false);
         return p->pou->rettype;
     }
@@ -812,7 +881,7 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
     bool *given = xalloc(sizeof(bool) * (size_t)(params.n + 1));
     int ninputs = 0;
     for (int i = 0; i < params.n; i++)
-        if (((Sym *)params.v[i])->cls != V_OUTPUT) ninputs++;
+        if (((Sym *)params.v[i])->cls != V_OUTPUT && !((Sym *)params.v[i])->implicit) ninputs++;
     for (int i = 0; i < call->list.n; i++) {
         Node *a = call->list.v[i];
         bool f = a->name != NULL;
@@ -830,7 +899,7 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
         }
         for (int i = 0; i < params.n && k < call->list.n; i++) {
             Sym *s = params.v[i];
-            if (s->cls == V_OUTPUT) continue;
+            if (s->cls == V_OUTPUT || s->implicit) continue;
             Node *a = call->list.v[k++];
             a->sym = s;
             a->name = s->name;
@@ -880,7 +949,8 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
     int missing = 0;
     for (int i = 0; i < params.n; i++) {
         Sym *s = params.v[i];
-        bool needed = s->cls == V_IN_OUT || (!is_fb && s->cls == V_INPUT && !s->decl->init);
+        /* a formal call may leave inputs out: they take their initial value */
+        bool needed = s->cls == V_IN_OUT || (formal == 0 && !is_fb && s->cls == V_INPUT && !s->decl->init && !s->implicit);
         if (!needed || given[i]) continue;
         if (formal == 0 && !missing++)
             error_at(call->loc, "'%s' expects %d argument%s, got %d", p->name, ninputs, ninputs == 1 ? "" : "s",
@@ -891,6 +961,8 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
 }
 
 /* ---- builtin functions ---- */
+/* nargs < 0: extensible, at least -nargs inputs IN1, IN2, ... (MUX: K, IN0, ...);
+   the operator functions' operators are in opfns */
 static const struct { const char *name; int id; int nargs; const char *pnames[3]; } builtins[] = {
     {"TRUNC", B_TRUNC, 1, {"IN"}}, {"ABS", B_ABS, 1, {"IN"}}, {"SQRT", B_SQRT, 1, {"IN"}},
     {"LN", B_LN, 1, {"IN"}}, {"LOG", B_LOG, 1, {"IN"}}, {"EXP", B_EXP, 1, {"IN"}},
@@ -901,8 +973,25 @@ static const struct { const char *name; int id; int nargs; const char *pnames[3]
     {"MUX", B_MUX, -3, {0}}, {"MOVE", B_MOVE, 1, {"IN"}}, {"SHL", B_SHL, 2, {"IN", "N"}},
     {"SHR", B_SHR, 2, {"IN", "N"}}, {"ROL", B_ROL, 2, {"IN", "N"}}, {"ROR", B_ROR, 2, {"IN", "N"}},
     {"LEN", B_LEN, 1, {"IN"}},
+    /* IEC 61131-3 tables 24, 26, 28: the operators as functions (opfns) */
+    {"ADD", B_OP, -2, {0}}, {"MUL", B_OP, -2, {0}}, {"SUB", B_OP, 2, {"IN1", "IN2"}},
+    {"DIV", B_DIV, 2, {"IN1", "IN2"}}, {"MOD", B_OP, 2, {"IN1", "IN2"}},
+    {"AND", B_OP, -2, {0}}, {"OR", B_OP, -2, {0}}, {"XOR", B_OP, -2, {0}}, {"NOT", B_OP, 1, {"IN"}},
+    {"GT", B_OP, -2, {0}}, {"GE", B_OP, -2, {0}}, {"EQ", B_OP, -2, {0}},
+    {"LE", B_OP, -2, {0}}, {"LT", B_OP, -2, {0}}, {"NE", B_OP, 2, {"IN1", "IN2"}},
     {NULL, 0, 0, {0}},
 };
+
+static const char *const opfns[][2] = {
+    {"ADD", "+"}, {"MUL", "*"}, {"SUB", "-"}, {"DIV", "/"}, {"MOD", "MOD"}, {"AND", "AND"}, {"OR", "OR"},
+    {"XOR", "XOR"}, {"NOT", "NOT"}, {"GT", ">"}, {"GE", ">="}, {"EQ", "="}, {"LE", "<="}, {"LT", "<"}, {"NE", "<>"},
+};
+
+static const char *opfn_op(const char *uname) {
+    for (size_t i = 0; i < sizeof opfns / sizeof opfns[0]; i++)
+        if (!strcmp(opfns[i][0], uname)) return opfns[i][1];
+    return NULL;
+}
 
 /* The elementary type named by the first len chars of s, or NULL. */
 static Type *prim_named(const char *s, size_t len) {
@@ -914,9 +1003,7 @@ static Type *prim_named(const char *s, size_t len) {
 }
 
 /* Put formal builtin arguments in positional order. */
-static bool order_builtin_args(Node *n, int id) {
-    int nb = -1;
-    for (int i = 0; builtins[i].name; i++) if (builtins[i].id == id) nb = i;
+static bool order_builtin_args(Node *n, int id, int nb) {
     bool formal = n->list.n && ((Node *)n->list.v[0])->name;
     if (!formal) {
         for (int i = 0; i < n->list.n; i++)
@@ -987,7 +1074,109 @@ static Type *generic_args(Ctx *c, Node *n, int from, Type *want) {
     return t;
 }
 
+/* EN := and ENO => of a standard function call leave its argument list. */
+static bool split_en_eno(Node *n) {
+    int k = 0;
+    for (int i = 0; i < n->list.n; i++) {
+        Node *a = n->list.v[i];
+        if (a->uname && !strcmp(a->uname, "EN")) {
+            if (a->is_out) { error_at(a->loc, "'EN' is not an output of '%s'", n->name); return false; }
+            n->en = a->lhs;
+            continue;
+        }
+        if (a->uname && !strcmp(a->uname, "ENO")) {
+            if (!a->is_out) { error_at(a->loc, "cannot connect output 'ENO' with ':=': use '=>'"); return false; }
+            if (a->negated) { error_at(a->loc, "negated output connections are not supported"); return false; }
+            n->eno = a;
+            continue;
+        }
+        n->list.v[k++] = a;
+    }
+    n->list.n = k;
+    return true;
+}
+
+static void check_en_eno(Ctx *c, Node *n) {
+    if (n->en) {
+        check(c, n->en, ty_prim[T_BOOL]);
+        check_transfer(ty_prim[T_BOOL], n->en, "type mismatch: parameter '%s' of '%s' expects %4$s, got %3$s", "EN", n->name);
+    }
+    if (n->eno && n->eno->lhs) {
+        Type *t = check(c, n->eno->lhs, ty_prim[T_BOOL]);
+        if (is_err(t)) return;
+        check_writable(c, n->eno->lhs);
+        if (canon(t)->kind != T_BOOL)
+            error_at(n->eno->lhs->start, "type mismatch: output 'ENO' of '%s' is BOOL, its target %s", n->name, type_name(t));
+    }
+}
+
+static bool has_call(Node *n) {
+    if (!n) return false;
+    if (n->kind == N_CALL) return true;
+    if (has_call(n->lhs) || has_call(n->rhs)) return true;
+    for (int i = 0; i < n->list.n; i++) if (has_call(n->list.v[i])) return true;
+    return false;
+}
+
+static Node *clone_expr(Node *n) {
+    if (!n) return NULL;
+    Node *x = xalloc(sizeof *x);
+    *x = *n;
+    x->lhs = clone_expr(n->lhs);
+    x->rhs = clone_expr(n->rhs);
+    x->list = (Vec){0};
+    for (int i = 0; i < n->list.n; i++) vec_push(&x->list, clone_expr(n->list.v[i]));
+    return x;
+}
+
+static Node *op_node(Node *call, const char *op, Node *l, Node *r) {
+    Node *x = xalloc(sizeof *x);
+    x->kind = r ? N_BINARY : N_UNARY;
+    x->loc = call->loc;
+    x->start = l->start;
+    x->op = op;
+    x->name = call->name;    /* diagnostics name the function, not the operator */
+    x->lhs = l;
+    x->rhs = r;
+    return x;
+}
+
+/* ADD(a, b, c) is (a + b) + c; GT(a, b, c) is a > b AND b > c (IEC 61131-3
+   tables 24 and 28); NOT(a) is NOT a. The call keeps the operator tree. */
+static Type *operator_function(Ctx *c, Node *n, const char *op, Type *want) {
+    Node *x;
+    bool cmp = !strcmp(op, ">") || !strcmp(op, ">=") || !strcmp(op, "=") || !strcmp(op, "<=") || !strcmp(op, "<");
+    if (!strcmp(op, "NOT")) {
+        x = op_node(n, op, arg(n, 0), NULL);
+    } else if (cmp && n->list.n > 2) {
+        for (int i = 1; i + 1 < n->list.n; i++)
+            if (has_call(arg(n, i))) {
+                error_at(arg(n, i)->start, "'%s' with more than two inputs compares each middle input twice: "
+                         "a function call there is not supported, give it a variable", n->name);
+                return err_type();
+            }
+        x = NULL;
+        for (int i = 0; i + 1 < n->list.n; i++) {
+            Node *pair = op_node(n, op, i ? clone_expr(arg(n, i)) : arg(n, i), arg(n, i + 1));
+            x = x ? op_node(n, "AND", x, pair) : pair;
+        }
+    } else {
+        x = arg(n, 0);
+        for (int i = 1; i < n->list.n; i++) x = op_node(n, op, x, arg(n, i));
+    }
+    n->opx = x;
+    return check(c, x, want);
+}
+
+static Type *builtin_value(Ctx *c, Node *n, Type *want);
+
 static Type *check_builtin(Ctx *c, Node *n, Type *want) {
+    Type *t = builtin_value(c, n, want);
+    if (t && !is_err(t)) check_en_eno(c, n);
+    return t;
+}
+
+static Type *builtin_value(Ctx *c, Node *n, Type *want) {
     int id = 0, nb = -1;
     Type *from = NULL, *to = NULL;
     const char *us = strstr(n->uname, "_TO_");
@@ -1001,7 +1190,7 @@ static Type *check_builtin(Ctx *c, Node *n, Type *want) {
             if (!strcmp(builtins[i].name, n->uname)) { id = builtins[i].id; nb = i; }
     if (!id) return NULL;
     n->builtin = id;
-    if (!order_builtin_args(n, id)) return err_type();
+    if (!split_en_eno(n) || !order_builtin_args(n, id, nb)) return err_type();
     int want_n = id == B_CONV ? 1 : builtins[nb].nargs;
     if ((want_n > 0 && n->list.n != want_n) || (want_n < 0 && n->list.n < -want_n)) {
         if (want_n > 0)
@@ -1093,6 +1282,13 @@ static Type *check_builtin(Ctx *c, Node *n, Type *want) {
         if (!is_int(s->ty)) { error_at(s->start, "type mismatch: parameter 'N' of '%s' expects ANY_INT, got %s", n->name, type_name(s->ty)); return err_type(); }
         return t;
     }
+    case B_OP: case B_DIV:
+        t = operator_function(c, n, opfn_op(n->uname), want);
+        if (id == B_DIV && !is_err(t) && !is_num(t)) {
+            error_at(n->loc, "'DIV' needs numbers, not %s", type_name(t));
+            return err_type();
+        }
+        return t;
     case B_LEN: {
         Node *a = arg(n, 0);
         t = check(c, a, ty_prim[T_STRING]);
@@ -1397,6 +1593,16 @@ static Sym *declare_var(Ctx *c, Vec *scope, VarDecl *d, Pou *p) {
         error_at(d->loc, "a function cannot hold a function block instance");
     if (canon(s->type)->kind == T_FB && (d->cls == V_INPUT || d->cls == V_OUTPUT))
         error_at(d->loc, "function block instances as inputs or outputs are not supported");
+    if (is_en_eno(d->uname)) {   /* declared out loud, as matiec allows: the same flag */
+        bool en = !strcmp(d->uname, "EN");
+        if (!p || p->kind == POU_PROGRAM || d->cls != (en ? V_INPUT : V_OUTPUT) || canon(s->type)->kind != T_BOOL) {
+            error_at(d->loc, "'%s' is the %s of every function and function block: declare it only there, as %s %s : BOOL",
+                     d->name, en ? "enable input" : "enable output", en ? "VAR_INPUT" : "VAR_OUTPUT", d->uname);
+            return NULL;
+        }
+        if (en) p->en = s;
+        else p->eno = s;
+    }
     vec_push(scope, s);
     return s;
 }

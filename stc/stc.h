@@ -121,6 +121,8 @@ struct Node {
     Pou *callee;      /* called POU (user function or FB type) */
     int builtin;      /* builtin function id, when > 0 */
     Type *conv_from;  /* builtin conversions and generic functions: operand type */
+    Node *en, *eno;   /* standard function calls: EN := input, ENO => target */
+    Node *opx;        /* operator functions (ADD, GT, ...): the operator expression they mean */
     bool is_const;    /* constant expression */
     int64_t cval;     /* its integer value when is_const */
 };
@@ -170,6 +172,7 @@ struct Pou {
     Type *type;           /* FB / program: its instance type */
     Vec syms;             /* Sym of its variables, in declaration order */
     Vec calls;            /* functions it calls (Pou*) */
+    Sym *en, *eno;        /* its EN input and ENO output, once a call or a body uses them */
 };
 
 typedef struct TypeDecl { char *name, *uname; Loc loc; TypeSpec *spec; Node *init; } TypeDecl;
@@ -257,6 +260,7 @@ struct Sym {
     bool in_function;     /* variable of a FUNCTION: C local or parameter */
     bool is_result;       /* the function's return variable */
     bool loop_locked;     /* FOR control variable inside its loop */
+    bool implicit;        /* EN / ENO nobody declared: never a positional argument */
 };
 
 extern Type *ty_prim[T__COUNT];
@@ -286,6 +290,8 @@ enum {
     B_NONE, B_CONV, B_TRUNC, B_ABS, B_SQRT, B_LN, B_LOG, B_EXP, B_SIN, B_COS, B_TAN,
     B_ASIN, B_ACOS, B_ATAN, B_EXPT, B_SEL, B_MAX, B_MIN, B_LIMIT, B_MUX, B_MOVE,
     B_SHL, B_SHR, B_ROL, B_ROR, B_LEN,
+    B_OP,       /* ADD, SUB, ..., GT, ..., NOT: Node.opx holds the operator expression */
+    B_DIV,      /* DIV: like '/', and ENO is FALSE on a zero divisor */
 };
 
 #endif
