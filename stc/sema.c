@@ -1011,8 +1011,10 @@ static bool order_builtin_args(Node *n, int id, int nb) {
         return true;
     }
     int cnt = n->list.n;
+    bool fixed = nb >= 0 && builtins[nb].nargs > 1 && builtins[nb].nargs >= cnt;
+    if (fixed) cnt = builtins[nb].nargs;
     Node **ord = xalloc(sizeof(Node *) * (size_t)(cnt + 1));
-    for (int i = 0; i < cnt; i++) {
+    for (int i = 0; i < n->list.n; i++) {
         Node *a = n->list.v[i];
         if (!a->name || a->is_out) { error_at(a->loc, "cannot mix formal (name := value) and positional arguments"); return false; }
         int pos = -1;
@@ -1033,9 +1035,13 @@ static bool order_builtin_args(Node *n, int id, int nb) {
         ord[pos] = a;
     }
     for (int i = 0; i < cnt; i++) {
-        if (!ord[i]) { error_at(n->loc, "missing parameter for '%s'", n->name); return false; }
-        n->list.v[i] = ord[i];
+        if (!ord[i]) {
+            if (fixed) error_at(n->loc, "missing parameter '%s' for '%s'", builtins[nb].pnames[i], n->name);
+            else error_at(n->loc, "missing parameter for '%s'", n->name);
+            return false;
+        }
     }
+    for (int i = 0; i < cnt; i++) n->list.v[i] = ord[i];
     return true;
 }
 
