@@ -397,6 +397,13 @@ static void builtin(G *g, Buf *b, Node *n) {
         call_fn(g, b, fn, n, 2, "LINT");
         return;
     case B_OP: expr(g, b, n->opx); return;
+    case B_CONCAT: {
+        int k = n->list.n;
+        for (int i = 0; i < k - 1; i++) buf_put(b, "__str_concat(");
+        expr(g, b, arg(n, 0));
+        for (int i = 1; i < k; i++) { buf_put(b, ", "); expr(g, b, arg(n, i)); buf_put(b, ")"); }
+        return;
+    }
     case B_DIV:   /* matiec's DIV: a zero divisor gives 0 and ENO = FALSE */
         buf_printf(b, "__DIVF_%s(", t->cname);
         expr(g, b, arg(n, 0));

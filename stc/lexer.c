@@ -325,6 +325,9 @@ static void lex_location(Lexer *L) {
         if (p + 1 < end && *p == '.' && isdigit((unsigned char)p[1])) p++;
         else break;
     }
+    if (p < end && *p == '*')
+        fatal_at(here(L, s), "partly specified locations like '%.*s*' are not supported by stc: give the full address",
+                 (int)(p - s), s);
     if (!ok || (p < end && ident_char((unsigned char)*p))) {
         while (p < end && (ident_char((unsigned char)*p) || *p == '.')) p++;
         fatal_at(here(L, s), "malformed location '%.*s'", (int)(p - s), s);
@@ -400,6 +403,8 @@ Token *lex(const Source *src, int *count) {
             }
         }
         if (!matched) {
+            if (c == '^') fatal_at(here(&L, p), "pointer dereference '^' is not supported by stc");
+            if (c == '?' && p + 1 < L.end && p[1] == '=') fatal_at(here(&L, p), "assignment attempt '?=' is not supported by stc");
             if (c >= 0x20 && c < 0x7f) fatal_at(here(&L, p), "unexpected character '%c'", c);
             fatal_at(here(&L, p), "unexpected byte 0x%02X", c);
         }

@@ -71,6 +71,24 @@ static Token *ident(P *p, const char *what) {
     return next(p);
 }
 
+/* Constructs stc does not compile, named in the diagnostic. */
+static bool is_one_of(Token *t, const char *const *names) {
+    if (t->kind != TK_IDENT) return false;
+    for (; *names; names++) if (!strcmp(t->up, *names)) return true;
+    return false;
+}
+static const char *const oop_words[] = {"CLASS", "INTERFACE", "NAMESPACE", "METHOD", "PROPERTY", "EXTENDS", "IMPLEMENTS", NULL};
+static const char *const sfc_words[] = {"INITIAL_STEP", "STEP", "TRANSITION", "ACTION", NULL};
+static const char *const il_ops[] = {"LD", "LDN", "ST", "STN", "S", "R", "ANDN", "ORN", "XORN", "CAL", "CALC", "CALCN",
+                                    "JMPC", "JMPCN", "RET", "RETC", "RETCN", NULL};
+static const char *const unsupported_types[] = {"WSTRING", "CHAR", "WCHAR", "LTIME", "LDATE", "LTOD", "LDT",
+                                               "LTIME_OF_DAY", "LDATE_AND_TIME", NULL};
+
+static void unsupported_oop(Token *t) {
+    if (t->kind == TK_IDENT && is_one_of(t, oop_words))
+        fatal_at(t->loc, "object-oriented ST (%s) is not supported by stc", t->up);
+}
+
 static Node *new_node(NodeKind k, Token *t) {
     Node *n = xalloc(sizeof *n);
     n->kind = k;
@@ -211,6 +229,8 @@ static Node *primary(P *p) {
         }
         bool opfn = (is_kw(t, "AND") || is_kw(t, "OR") || is_kw(t, "XOR") || is_kw(t, "NOT") || is_kw(t, "MOD")) &&
                     is_p(peek(p, 1), "(");   /* the operator functions AND(a, b), ... */
+        if (is_kw(t, "TIME") && is_p(peek(p, 1), "("))
+            fatal_at(t->loc, "TIME() is CODESYS's clock, not a standard function: stc does not support it");
         if (is_reserved(t->up) && !opfn) {
             /* type-named conversion calls like INT_TO_REAL are not reserved; these are */
             fatal_at(t->loc, "expected expression, found keyword '%s'", t->text);
@@ -416,6 +436,7 @@ static TypeSpec *new_spec(TSKind k, Token *t) {
 
 static Node *range(P *p) {
     Token *t = cur(p);
+    if (is_p(t, "*")) fatal_at(t->loc, "variable-length arrays (ARRAY[*]) are not supported by stc");
     Node *r = new_node(N_RANGE, t);
     r->lhs = expr(p);
     expect_p(p, "..");
@@ -462,6 +483,9 @@ static TypeSpec *type_spec(P *p) {
         return s;
     }
     if (t->kind != TK_IDENT) expected(p, "type name");
+    if (is_one_of(t, unsupported_types)) fatal_at(t->loc, "type %s is not supported by stc", t->up);
+    if (is_kw(t, "REF_TO") || is_kw(t, "POINTER") || is_kw(t, "REFERENCE"))
+        fatal_at(t->loc, "pointers and references (%s) are not supported by stc", t->up);
     next(p);
     if (is_p(cur(p), "(")) {                 /* subrange: INT (lo..hi) */
         next(p);
@@ -511,6 +535,9 @@ static void var_decls(P *p, Vec *out, VarClass cls, bool constant, bool retain, 
         }
         next(p);
         TypeSpec *spec = type_spec(p);
+        if (is_kw(cur(p), "R_EDGE") || is_kw(cur(p), "F_EDGE"))
+            fatal_at(cur(p)->loc, "edge-detecting inputs (%s) are not supported by stc: use an %s_TRIG", cur(p)->up,
+                     cur(p)->up[0] == 'R' ? "R" : "F");
         Node *init = NULL;
         if (accept_p(p, ":=")) init = init_value(p);
         expect_p(p, ";");
@@ -692,6 +719,15 @@ static Node *statement(P *p) {
         accept_p(p, ";");
         return n;
     }
+    if (is_one_of(t, sfc_words))
+        fatal_at(t->loc, "Sequential Function Chart (%s) is not supported by stc", t->up);
+    unsupported_oop(t);
+    if (is_kw(t, "CONTINUE") && is_p(peek(p, 1), ";"))
+        fatal_at(t->loc, "CONTINUE is not supported by stc (nor by matiec): put the rest of the loop body under an IF");
+    if (is_kw(t, "JMP") || (t->kind == TK_IDENT && !is_reserved(t->up) && is_p(peek(p, 1), ":") && !is_p(peek(p, 2), "=")))
+        fatal_at(t->loc, "jumps and labels are not supported by stc");
+    if (is_one_of(t, il_ops) && (peek(p, 1)->kind == TK_IDENT || peek(p, 1)->kind == TK_INT || peek(p, 1)->kind == TK_LOCATION))
+        fatal_at(t->loc, "Instruction List (IL) is not supported by stc: it compiles Structured Text");
     if (is_kw(t, "EXIT")) { next(p); expect_p(p, ";"); return new_node(S_EXIT, t); }
     if (is_kw(t, "RETURN")) { next(p); expect_p(p, ";"); return new_node(S_RETURN, t); }
     if (t->kind == TK_IDENT && !is_reserved(t->up)) {
@@ -760,6 +796,7 @@ static void pou(P *p) {
     u->uname = name->up;
     u->loc = name->loc;
     u->from_lib = p->lib;
+    unsupported_oop(cur(p));
     if (u->kind == POU_FUNCTION) {
         expect_p(p, ":");
         u->ret = type_spec(p);
@@ -895,6 +932,10 @@ void parse_unit(Unit *u, const Source *src, bool from_lib) {
         else if (is_kw(t, "TYPE")) type_block(&p);
         else if (is_kw(t, "CONFIGURATION")) configuration(&p);
         else if (is_p(t, ";")) next(&p);
-        else expected(&p, "FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
+        else {
+            unsupported_oop(t);
+            if (is_one_of(t, sfc_words)) fatal_at(t->loc, "Sequential Function Chart (%s) is not supported by stc", t->up);
+            expected(&p, "FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
+        }
     }
 }

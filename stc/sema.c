@@ -101,6 +101,42 @@ static Sym *find(Vec *v, const char *uname) {
     return NULL;
 }
 
+/* ---- "did you mean": the declared name nearest to a misspelt one ---- */
+typedef struct { const char *want; const char *best; int dist; } Near;
+
+static int edit_distance(const char *a, const char *b) {   /* upper-case names */
+    size_t n = strlen(a), m = strlen(b);
+    if (n > 63 || m > 63) return 99;
+    int row[64], prev[64];
+    for (size_t j = 0; j <= m; j++) prev[j] = (int)j;
+    for (size_t i = 1; i <= n; i++) {
+        row[0] = (int)i;
+        for (size_t j = 1; j <= m; j++) {
+            int sub = prev[j - 1] + (a[i - 1] != b[j - 1]);
+            int del = prev[j] + 1, ins = row[j - 1] + 1;
+            row[j] = sub < del ? (sub < ins ? sub : ins) : (del < ins ? del : ins);
+        }
+        memcpy(prev, row, sizeof(int) * (m + 1));
+    }
+    return prev[m];
+}
+
+static void near_name(Near *nr, const char *name) {
+    char *up = upcase(name);
+    if (!strcmp(up, nr->want)) return;
+    int d = edit_distance(nr->want, up);
+    size_t len = strlen(nr->want);
+    int limit = len <= 3 ? 1 : len <= 6 ? 2 : 3;
+    if (d <= limit && (!nr->best || d < nr->dist)) { nr->best = name; nr->dist = d; }
+}
+
+static void near_syms(Near *nr, Vec *v) {
+    for (int i = 0; v && i < v->n; i++) near_name(nr, ((Sym *)v->v[i])->name);
+}
+
+/* "; did you mean 'x'?" or "" */
+static const char *near_hint(Near *nr) { return nr->best ? fmt("; did you mean '%s'?", nr->best) : ""; }
+
 static Sym *new_sym(SymKind k, char *name, char *uname, Loc loc) {
     Sym *s = xalloc(sizeof *s);
     s->kind = k;
@@ -201,7 +237,12 @@ static Type *named_type(Ctx *c, const char *uname, Loc loc, const char *spelled)
     Sym *p = find(&c->pous, uname);
     if (p && p->pou->kind != POU_FUNCTION) { p->pou->used = true; return p->pou->type; }
     if (p) { error_at(loc, "'%s' is a function, not a type", spelled); return err_type(); }
-    error_at(loc, "unknown type '%s'", spelled);
+    Near nr = {uname, NULL, 0};
+    for (int k = 0; k <= T_STRING; k++) near_name(&nr, ty_prim[k]->name);
+    near_syms(&nr, &c->types);
+    for (int i = 0; i < c->pous.n; i++)
+        if (((Sym *)c->pous.v[i])->pou->kind == POU_FB) near_name(&nr, ((Sym *)c->pous.v[i])->name);
+    error_at(loc, "unknown type '%s'%s", spelled, near_hint(&nr));
     return err_type();
 }
 
@@ -529,7 +570,11 @@ static Type *check_ident(Ctx *c, Node *n, Type *want) {
         return err_type();
     }
     if (type_sym(c, n->uname)) { error_at(n->loc, "'%s' is a type, not a variable", n->name); return err_type(); }
-    error_at(n->loc, "undeclared identifier '%s'", n->name);
+    Near nr = {n->uname, NULL, 0};
+    near_syms(&nr, c->scope);
+    if (!c->pou) { near_syms(&nr, c->gscope[0]); near_syms(&nr, c->gscope[1]); }
+    near_syms(&nr, &c->enumvals);
+    error_at(n->loc, "undeclared identifier '%s'%s", n->name, near_hint(&nr));
     return err_type();
 }
 
@@ -597,7 +642,15 @@ static Type *check_member(Ctx *c, Node *n) {
                  t->name);
         return err_type();
     }
-    error_at(n->loc, "no member '%s' in '%s'", n->name, t->name);
+    Near nr = {n->uname, NULL, 0};
+    if (t->kind == T_STRUCT)
+        for (int i = 0; i < t->fields.n; i++) near_name(&nr, ((Field *)t->fields.v[i])->name);
+    else
+        for (int i = 0; i < t->pou->syms.n; i++) {
+            Sym *m = t->pou->syms.v[i];
+            if (m->cls == V_INPUT || m->cls == V_OUTPUT || m->cls == V_IN_OUT) near_name(&nr, m->name);
+        }
+    error_at(n->loc, "no member '%s' in '%s'%s", n->name, t->name, near_hint(&nr));
     return err_type();
 }
 
@@ -821,6 +874,8 @@ static void uses_en_eno(Node *call, Pou *p) {
     }
 }
 
+static void near_builtins(Near *nr);
+
 static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
     if (n->lhs) {      /* a[i](...): the instance is an expression */
         Type *it = check(c, n->lhs, NULL);
@@ -865,8 +920,19 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
     }
     Type *b = check_builtin(c, n, want);
     if (b) return b;
-    if (v) error_at(n->loc, "'%s' is not a function", n->name);
-    else error_at(n->loc, "'%s' is not a function", n->name);
+    const char *unsupported[] = {"LEFT", "RIGHT", "MID", "INSERT", "DELETE", "REPLACE", "FIND", NULL};
+    for (int i = 0; unsupported[i]; i++)
+        if (!strcmp(unsupported[i], n->uname)) {
+            error_at(n->loc, "the standard function %s is not supported by stc", n->uname);
+            return err_type();
+        }
+    if (v) { error_at(n->loc, "'%s' is not a function", n->name); return err_type(); }
+    Near nr = {n->uname, NULL, 0};
+    for (int i = 0; i < c->pous.n; i++)
+        if (((Sym *)c->pous.v[i])->pou->kind == POU_FUNCTION) near_name(&nr, ((Sym *)c->pous.v[i])->name);
+    near_builtins(&nr);
+    near_syms(&nr, c->scope);
+    error_at(n->loc, "'%s' is not a function%s", n->name, near_hint(&nr));
     return err_type();
 }
 
@@ -913,7 +979,9 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
         for (int j = 0; j < params.n; j++)
             if (!strcmp(((Sym *)params.v[j])->uname, a->uname)) pi = j;
         if (pi < 0) {
-            error_at(a->loc, "unknown parameter '%s' for '%s'", a->name, p->name);
+            Near nr = {a->uname, NULL, 0};
+            near_syms(&nr, &params);
+            error_at(a->loc, "unknown parameter '%s' for '%s'%s", a->name, p->name, near_hint(&nr));
             if (a->lhs) check(c, a->lhs, NULL);
             continue;
         }
@@ -979,6 +1047,7 @@ static const struct { const char *name; int id; int nargs; const char *pnames[3]
     {"AND", B_OP, -2, {0}}, {"OR", B_OP, -2, {0}}, {"XOR", B_OP, -2, {0}}, {"NOT", B_OP, 1, {"IN"}},
     {"GT", B_OP, -2, {0}}, {"GE", B_OP, -2, {0}}, {"EQ", B_OP, -2, {0}},
     {"LE", B_OP, -2, {0}}, {"LT", B_OP, -2, {0}}, {"NE", B_OP, 2, {"IN1", "IN2"}},
+    {"CONCAT", B_CONCAT, -2, {0}},
     {NULL, 0, 0, {0}},
 };
 
@@ -986,6 +1055,10 @@ static const char *const opfns[][2] = {
     {"ADD", "+"}, {"MUL", "*"}, {"SUB", "-"}, {"DIV", "/"}, {"MOD", "MOD"}, {"AND", "AND"}, {"OR", "OR"},
     {"XOR", "XOR"}, {"NOT", "NOT"}, {"GT", ">"}, {"GE", ">="}, {"EQ", "="}, {"LE", "<="}, {"LT", "<"}, {"NE", "<>"},
 };
+
+static void near_builtins(Near *nr) {
+    for (int i = 0; builtins[i].name; i++) near_name(nr, builtins[i].name);
+}
 
 static const char *opfn_op(const char *uname) {
     for (size_t i = 0; i < sizeof opfns / sizeof opfns[0]; i++)
@@ -1270,6 +1343,13 @@ static Type *builtin_value(Ctx *c, Node *n, Type *want) {
         if (!is_err(t) && !is_elementary(t)) { error_at(n->loc, "'MUX' supports elementary types only"); return err_type(); }
         return t;
     }
+    case B_CONCAT:
+        t = generic_args(c, n, 0, want);
+        if (!is_err(t) && canon(t)->kind != T_STRING) {
+            error_at(n->loc, "'CONCAT' joins strings, not %s", type_name(t));
+            return err_type();
+        }
+        return t;
     case B_MAX: case B_MIN: case B_LIMIT:
         t = generic_args(c, n, 0, want);
         if (!is_err(t) && !is_num(t) && !is_bit(t) && !is_timeish(t)) {
@@ -1718,11 +1798,18 @@ static void check_config(Ctx *c, Config *cf) {
             if (pi->task) {
                 for (int j = 0; j < res->tasks.n; j++)
                     if (!strcmp(((Task *)res->tasks.v[j])->uname, pi->task)) pi->t = res->tasks.v[j];
-                if (!pi->t) error_at(pi->taskloc, "undeclared task '%s'", pi->task);
+                if (!pi->t) {
+                    Near nr = {pi->task, NULL, 0};
+                    for (int j = 0; j < res->tasks.n; j++) near_name(&nr, ((Task *)res->tasks.v[j])->name);
+                    error_at(pi->taskloc, "undeclared task '%s'%s", pi->task, near_hint(&nr));
+                }
             }
             Sym *ps = find(&c->pous, pi->pou);
             if (!ps || ps->pou->kind != POU_PROGRAM) {
-                error_at(pi->pouloc, ps ? "'%s' is not a PROGRAM" : "unknown program '%s'", pi->pou);
+                Near nr = {pi->pou, NULL, 0};
+                for (int j = 0; !ps && j < c->pous.n; j++)
+                    if (((Sym *)c->pous.v[j])->pou->kind == POU_PROGRAM) near_name(&nr, ((Sym *)c->pous.v[j])->name);
+                error_at(pi->pouloc, ps ? "'%s' is not a PROGRAM%s" : "unknown program '%s'%s", pi->pou, near_hint(&nr));
                 continue;
             }
             pi->p = ps->pou;

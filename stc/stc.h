@@ -292,6 +292,7 @@ enum {
     B_SHL, B_SHR, B_ROL, B_ROR, B_LEN,
     B_OP,       /* ADD, SUB, ..., GT, ..., NOT: Node.opx holds the operator expression */
     B_DIV,      /* DIV: like '/', and ENO is FALSE on a zero divisor */
+    B_CONCAT,
 };
 
 #endif

@@ -67,6 +67,14 @@ static inline IEC_TIME __dt_to_date(IEC_TIME t) {
 }
 
 /* ---- strings ---- */
+/* CONCAT: what does not fit in STR_MAX_LEN characters is cut off. */
+static inline STRING __str_concat(STRING a, STRING b) {
+    int n = b.len;
+    if (a.len + n > STR_MAX_LEN) n = STR_MAX_LEN - a.len;
+    memcpy(a.body + a.len, b.body, (size_t)n);
+    a.len = (uint8_t)(a.len + n);
+    return a;
+}
 static inline int __str_cmp(STRING a, STRING b) {
     int n = a.len < b.len ? a.len : b.len;
     int c = memcmp(a.body, b.body, (size_t)n);
