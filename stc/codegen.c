@@ -1110,14 +1110,31 @@ int codegen(Unit *u, const char *outdir) {
                 buf_printf(&csv, "%d;FB;%s;%s;%s;;%d;\n", num++, vp, vp, pi->p->type->cname, pi->retain);
                 csv_vars(&csv, &num, pi->p, vp, pi->retain);
             }
+            /* SINGLE tasks: the trigger's value at the last tick, for its rising edge */
+            for (int i = 0; i < res->tasks.n; i++) {
+                Task *t = res->tasks.v[i];
+                if (!t->single) continue;
+                buf_printf(&rc, "static BOOL __stc_single_%s;\n", t->uname);
+                buf_printf(&rinit, "  __stc_single_%s = 0;\n", t->uname);
+            }
             buf_printf(&rc, "\nvoid %s_init__(void) {\n  BOOL retain = 0;\n%s  (void)retain;\n}\n\n", res->uname,
                        rinit.s ? rinit.s : "");
             buf_printf(&rc, "void %s_run__(unsigned long tick) {\n", res->uname);
+            for (int i = 0; i < res->tasks.n; i++) {
+                Task *t = res->tasks.v[i];
+                if (!t->single || !t->single->sym) continue;
+                buf_printf(&rc, "  BOOL __stc_now_%s = ", t->uname);
+                expr(&g, &rc, t->single);
+                buf_printf(&rc, ";\n  BOOL __stc_run_%s = __stc_now_%s && !__stc_single_%s;\n", t->uname, t->uname, t->uname);
+                buf_printf(&rc, "  __stc_single_%s = __stc_now_%s;\n", t->uname, t->uname);
+            }
             bool used_tick = false;
             for (int i = 0; i < res->progs.n; i++) {
                 ProgInst *pi = res->progs.v[i];
                 if (!pi->p) continue;
-                if (pi->t && pi->t->interval_ns > 0) {
+                if (pi->t && pi->t->single) {
+                    buf_printf(&rc, "  if (__stc_run_%s) ", pi->t->uname);
+                } else if (pi->t && pi->t->interval_ns > 0) {
                     int64_t k = pi->t->interval_ns / tick;
                     uint64_t gg = (uint64_t)gcd64((int64_t)lcm, k);
                     lcm = lcm / gg * (uint64_t)k;

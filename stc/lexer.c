@@ -343,6 +343,7 @@ static const char *puncts[] = {
 
 Token *lex(const Source *src, int *count) {
     Lexer L = {src, src->text, src->text + src->len, 1, src->text, {0}};
+    bool warned_single = false;   /* the target-C warning, once per file */
     while (L.p < L.end) {
         const char *p = L.p;
         unsigned char c = (unsigned char)*p;
@@ -367,9 +368,22 @@ Token *lex(const Source *src, int *count) {
                 Token *t = add(&L, TK_PRAGMA, p, p + 2);
                 t->sval = xstrndup(p + 2, (size_t)(e - p - 2));
                 advance_to(&L, e + 2);
-            } else {
-                advance_to(&L, e + 1);    /* { } pragmas: compiler hints, ignored */
+                continue;
             }
+            /* { ... }: matiec copies it into the C as it does {{ ... }}, except
+               its own {enable/disable code generation}, which stc ignores */
+            char *text = xstrndup(p + 1, (size_t)(e - p - 1));
+            if (!strncmp(text, "#include", 8)) fatal_at(here(&L, p), "{#include ...} pragmas are not supported by stc");
+            if (strcmp(text, "enable code generation") && strcmp(text, "disable code generation")) {
+                Token *t = add(&L, TK_PRAGMA, p, p + 1);
+                t->sval = text;
+                t->ival = 1;
+                if (!warned_single) {
+                    warning_at(t->loc, "'{ ... }' pragma copied into the generated C, as matiec does: its text must be C for the target");
+                    warned_single = true;
+                }
+            }
+            advance_to(&L, e + 1);
             continue;
         }
         if (isdigit(c)) { lex_number(&L); continue; }

@@ -505,6 +505,7 @@ static TypeSpec *type_spec(P *p) {
 static void var_decls(P *p, Vec *out, VarClass cls, bool constant, bool retain, Token *open, const char *end) {
     for (;;) {
         Token *t = cur(p);
+        if (t->kind == TK_PRAGMA && t->ival) { next(p); continue; }   /* { } hint in a declaration: dropped */
         if (t->kind != TK_IDENT || is_reserved(t->up)) {
             if (is_kw(t, end)) return;
             if (t->kind == TK_IDENT && (kw_prefix(t, "END_") || !strncmp(t->up, "VAR", 3) ||
@@ -801,7 +802,11 @@ static void pou(P *p) {
         expect_p(p, ":");
         u->ret = type_spec(p);
     }
-    while (var_block(p, &u->vars, false)) {}
+    for (;;) {   /* a { } pragma between VAR blocks is a declaration hint: dropped */
+        if (cur(p)->kind == TK_PRAGMA && cur(p)->ival && peek(p, 1)->kind == TK_IDENT &&
+            (is_kw(peek(p, 1), "VAR") || kw_prefix(peek(p, 1), "VAR_"))) { next(p); continue; }
+        if (!var_block(p, &u->vars, false)) break;
+    }
     stmt_list(p, &u->body);
     expect_end(p, t, what, end);
     vec_push(&p->u->pous, u);

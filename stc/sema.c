@@ -1774,7 +1774,17 @@ static void check_config(Ctx *c, Config *cf) {
             Task *t = res->tasks.v[i];
             for (int j = 0; j < i; j++)
                 if (!strcmp(((Task *)res->tasks.v[j])->uname, t->uname)) error_at(t->loc, "duplicate declaration of '%s'", t->name);
-            if (t->single) error_at(t->single->start, "SINGLE tasks are not supported");
+            if (t->single) {   /* runs on the rising edge of a global BOOL (matiec: an R_TRIG per task) */
+                c->gscope[1] = &cf->gsyms;
+                Type *st = t->single->kind == N_IDENT ? check(c, t->single, ty_prim[T_BOOL]) : NULL;
+                c->gscope[1] = NULL;
+                if (t->single->kind != N_IDENT || (!is_err(st) && (!t->single->sym || !t->single->sym->is_global)))
+                    error_at(t->single->start, "task SINGLE must name a global BOOL variable");
+                else if (!is_err(st) && canon(st)->kind != T_BOOL)
+                    error_at(t->single->start, "task SINGLE must be BOOL, not %s", type_name(st));
+                t->interval_ns = 0;   /* SINGLE wins over INTERVAL, as in matiec */
+                continue;
+            }
             if (!t->interval) { error_at(t->loc, "task '%s' needs an INTERVAL", t->name); continue; }
             Type *it = check(c, t->interval, ty_prim[T_TIME]);
             if (is_err(it)) continue;

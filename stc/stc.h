@@ -34,7 +34,9 @@ typedef struct { const Source *src; int line, col; } Loc;
 
 /* Print "file:line:col: error: msg", the source line and a caret. */
 void error_at(Loc loc, const char *f, ...) __attribute__((format(printf, 2, 3)));
-/* Same, then exit(1). */
+/* "file:line:col: warning: msg" and the line; compilation goes on. */
+void warning_at(Loc loc, const char *f, ...) __attribute__((format(printf, 2, 3)));
+/* Same as error_at, then exit(1). */
 _Noreturn void fatal_at(Loc loc, const char *f, ...) __attribute__((format(printf, 2, 3)));
 extern int error_count;
 /* When set, fatal errors jump here instead of exiting (for embedding and fuzzing). */
@@ -51,7 +53,7 @@ typedef enum {
     TK_TIME,     /* T#, TOD#, D#, DT# literal: tval (ns), tkind */
     TK_PUNCT,    /* operator or punctuation: up holds it */
     TK_LOCATION, /* %IX0.1 etc: text */
-    TK_PRAGMA,   /* {{ C code }}: sval */
+    TK_PRAGMA,   /* {{ C code }} or { C code }: sval; ival 1 for the single-brace form */
     TK_EOF,
 } TokKind;
 
