@@ -126,8 +126,8 @@ static void near_name(Near *nr, const char *name) {
     if (!strcmp(up, nr->want)) return;
     int d = edit_distance(nr->want, up);
     size_t len = strlen(nr->want);
-    int limit = len <= 3 ? 1 : len <= 6 ? 2 : 3;
-    if (d <= limit && (!nr->best || d < nr->dist)) { nr->best = name; nr->dist = d; }
+    int limit = len <= 2 ? 0 : len <= 4 ? 1 : len <= 7 ? 2 : 3;   /* one- and two-letter names: no guess */
+    if (d > 0 && d <= limit && (!nr->best || d < nr->dist)) { nr->best = name; nr->dist = d; }
 }
 
 static void near_syms(Near *nr, Vec *v) {
