@@ -806,6 +806,12 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         buf_put(b, g->pou && g->pou->kind == POU_FUNCTION ? "return __res;\n" : "return;\n");
         return;
     case S_PRAGMA:
+        if (g->pou && g->pou->kind == POU_FUNCTION) {
+            /* in matiec's C a function's result is a local named like the
+               function: C written for matiec assigns it under that name */
+            buf_printf(b, "  /* embedded C */\n#define %s __res\n%s\n#undef %s\n", g->pou->uname, s->sval, g->pou->uname);
+            return;
+        }
         buf_printf(b, "  /* embedded C */\n%s\n", s->sval);
         return;
     default:
