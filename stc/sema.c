@@ -1172,6 +1172,11 @@ static bool split_en_eno(Node *n) {
         n->list.v[k++] = a;
     }
     n->list.n = k;
+    for (int i = 0; (n->en || n->eno) && i < k; i++)   /* EN/ENO make a call formal (matiec too) */
+        if (!((Node *)n->list.v[i])->name) {
+            error_at(((Node *)n->list.v[i])->loc, "cannot mix formal (name := value) and positional arguments");
+            return false;
+        }
     return true;
 }
 
