@@ -446,7 +446,10 @@ static void builtin_en_eno(G *g, Buf *b, Node *n) {
     if (!n->en && !eno) { builtin(g, b, n); return; }
     buf_put(b, "(");
     if (n->en) { buf_put(b, "("); expr(g, b, n->en); buf_put(b, ") ? "); }
-    buf_printf(b, "(%s)(", cty(n->ty));
+    Type *t = ct(n->ty);   /* both branches in the value's C type; structures need no cast */
+    bool scalar = t->kind != T_STRING && !(t->kind >= T_TIME && t->kind <= T_DT) && t->kind != T_ARRAY && t->kind != T_STRUCT;
+    if (scalar) buf_printf(b, "(%s)", cty(n->ty));
+    buf_put(b, "(");
     if (eno && n->builtin != B_DIV) { buf_put(b, "("); expr(g, b, eno); buf_put(b, ") = 1, "); }
     builtin(g, b, n);
     buf_put(b, ")");
