@@ -720,6 +720,7 @@ static Node *statement(P *p) {
         accept_p(p, ";");
         return n;
     }
+    if (is_kw(t, "ACTION")) fatal_at(t->loc, "actions (ACTION ... END_ACTION) are not supported by stc");
     if (is_one_of(t, sfc_words))
         fatal_at(t->loc, "Sequential Function Chart (%s) is not supported by stc", t->up);
     unsupported_oop(t);
