@@ -396,6 +396,22 @@ static void builtin(G *g, Buf *b, Node *n) {
         snprintf(fn, sizeof fn, "__%s_%s", id == B_SHL ? "SHL" : id == B_SHR ? "SHR" : id == B_ROL ? "ROL" : "ROR", t->cname);
         call_fn(g, b, fn, n, 2, "LINT");
         return;
+    case B_OP: expr(g, b, n->opx); return;
+    case B_CONCAT: {
+        int k = n->list.n;
+        for (int i = 0; i < k - 1; i++) buf_put(b, "__str_concat(");
+        expr(g, b, arg(n, 0));
+        for (int i = 1; i < k; i++) { buf_put(b, ", "); expr(g, b, arg(n, i)); buf_put(b, ")"); }
+        return;
+    }
+    case B_DIV:   /* matiec's DIV: a zero divisor gives 0 and ENO = FALSE */
+        buf_printf(b, "__DIVF_%s(", t->cname);
+        expr(g, b, arg(n, 0));
+        buf_put(b, ", ");
+        expr(g, b, arg(n, 1));
+        if (n->eno && n->eno->lhs) { buf_put(b, ", &("); expr(g, b, n->eno->lhs); buf_put(b, "))"); }
+        else buf_put(b, ", NULL)");
+        return;
     case B_LEN:
         buf_put(b, "((INT)(");
         expr(g, b, arg(n, 0));
@@ -421,6 +437,29 @@ static void default_value(G *g, Buf *b, Type *t) {
     if (c->kind == T_ENUM) { buf_printf(b, "%s__%s", c->cname, (char *)c->fields.v[0]); return; }
     if (is_real(c)) { buf_printf(b, "((%s)0.0)", c->cname); return; }
     buf_printf(b, "((%s)0)", cty(t));
+}
+
+/* A standard function called with EN := or ENO =>: EN = FALSE skips it, gives
+   the type's initial value and ENO = FALSE (matiec's TEST_EN). */
+static void builtin_en_eno(G *g, Buf *b, Node *n) {
+    Node *eno = n->eno && n->eno->lhs ? n->eno->lhs : NULL;
+    if (!n->en && !eno) { builtin(g, b, n); return; }
+    buf_put(b, "(");
+    if (n->en) { buf_put(b, "("); expr(g, b, n->en); buf_put(b, ") ? "); }
+    Type *t = ct(n->ty);   /* both branches in the value's C type; structures need no cast */
+    bool scalar = t->kind != T_STRING && !(t->kind >= T_TIME && t->kind <= T_DT) && t->kind != T_ARRAY && t->kind != T_STRUCT;
+    if (scalar) buf_printf(b, "(%s)", cty(n->ty));
+    buf_put(b, "(");
+    if (eno && n->builtin != B_DIV) { buf_put(b, "("); expr(g, b, eno); buf_put(b, ") = 1, "); }
+    builtin(g, b, n);
+    buf_put(b, ")");
+    if (n->en) {
+        buf_put(b, " : ");
+        if (eno) { buf_put(b, "(("); expr(g, b, eno); buf_put(b, ") = 0, "); }
+        default_value(g, b, n->ty);
+        if (eno) buf_put(b, ")");
+    }
+    buf_put(b, ")");
 }
 
 static void call_user_function(G *g, Buf *b, Node *n) {
@@ -466,12 +505,22 @@ static void expr(G *g, Buf *b, Node *n) {
         return;
     case N_IDENT: var_ref(g, b, n->sym); return;
     case N_MEMBER:
+        if (n->sym && n->sym->kind == SK_VAR && n->sym->cls == V_IN_OUT) {
+            /* an instance's in-out from outside: what its last call connected;
+               before any call, a zero of the type */
+            buf_put(b, "(*(");
+            expr(g, b, n->lhs);
+            buf_printf(b, ".%s ? ", n->uname);
+            expr(g, b, n->lhs);
+            buf_printf(b, ".%s : &(%s){0}))", n->uname, cty(n->sym->type));
+            return;
+        }
         expr(g, b, n->lhs);
         buf_printf(b, ".%s", n->uname);
         return;
     case N_INDEX: index_expr(g, b, n); return;
     case N_CALL:
-        if (n->builtin) builtin(g, b, n);
+        if (n->builtin) builtin_en_eno(g, b, n);
         else call_user_function(g, b, n);
         return;
     case N_UNARY: {
@@ -760,6 +809,12 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         buf_put(b, g->pou && g->pou->kind == POU_FUNCTION ? "return __res;\n" : "return;\n");
         return;
     case S_PRAGMA:
+        if (g->pou && g->pou->kind == POU_FUNCTION) {
+            /* in matiec's C a function's result is a local named like the
+               function: C written for matiec assigns it under that name */
+            buf_printf(b, "  /* embedded C */\n#define %s __res\n%s\n#undef %s\n", g->pou->uname, s->sval, g->pou->uname);
+            return;
+        }
         buf_printf(b, "  /* embedded C */\n%s\n", s->sval);
         return;
     default:
@@ -803,6 +858,10 @@ static void emit_function(G *g, Pou *p) {
         buf_printf(b, "  (void)%s;\n", name);
     }
     buf_put(b, "  (void)retain;\n");
+    if (p->en) {   /* EN = FALSE: the result's initial value, ENO = FALSE */
+        buf_printf(b, "  if (!EN) { %sreturn __res; }\n", p->eno ? "*ENO = 0; " : "");
+        if (p->eno) buf_put(b, "  *ENO = 1;\n");
+    }
     stmts(g, b, &p->body, 1);
     buf_put(b, "  return __res;\n}\n\n");
     g->pou = NULL;
@@ -883,6 +942,10 @@ static void emit_fb(G *g, Pou *p) {
         buf_printf(b, "  (void)%s;\n", s->uname);
     }
     buf_put(b, "  (void)data__;\n");
+    if (p->en) {   /* EN = FALSE: the body does not run, ENO = FALSE */
+        buf_printf(b, "  if (!data__->EN) { %sreturn; }\n", p->eno ? "data__->ENO = 0; " : "");
+        if (p->eno) buf_put(b, "  data__->ENO = 1;\n");
+    }
     stmts(g, b, &p->body, 1);
     buf_put(b, "}\n\n");
     g->pou = NULL;
@@ -1098,14 +1161,31 @@ int codegen(Unit *u, const char *outdir) {
                 buf_printf(&csv, "%d;FB;%s;%s;%s;;%d;\n", num++, vp, vp, pi->p->type->cname, pi->retain);
                 csv_vars(&csv, &num, pi->p, vp, pi->retain);
             }
+            /* SINGLE tasks: the trigger's value at the last tick, for its rising edge */
+            for (int i = 0; i < res->tasks.n; i++) {
+                Task *t = res->tasks.v[i];
+                if (!t->single) continue;
+                buf_printf(&rc, "static BOOL __stc_single_%s;\n", t->uname);
+                buf_printf(&rinit, "  __stc_single_%s = 0;\n", t->uname);
+            }
             buf_printf(&rc, "\nvoid %s_init__(void) {\n  BOOL retain = 0;\n%s  (void)retain;\n}\n\n", res->uname,
                        rinit.s ? rinit.s : "");
             buf_printf(&rc, "void %s_run__(unsigned long tick) {\n", res->uname);
+            for (int i = 0; i < res->tasks.n; i++) {
+                Task *t = res->tasks.v[i];
+                if (!t->single || !t->single->sym) continue;
+                buf_printf(&rc, "  BOOL __stc_now_%s = ", t->uname);
+                expr(&g, &rc, t->single);
+                buf_printf(&rc, ";\n  BOOL __stc_run_%s = __stc_now_%s && !__stc_single_%s;\n", t->uname, t->uname, t->uname);
+                buf_printf(&rc, "  __stc_single_%s = __stc_now_%s;\n", t->uname, t->uname);
+            }
             bool used_tick = false;
             for (int i = 0; i < res->progs.n; i++) {
                 ProgInst *pi = res->progs.v[i];
                 if (!pi->p) continue;
-                if (pi->t && pi->t->interval_ns > 0) {
+                if (pi->t && pi->t->single) {
+                    buf_printf(&rc, "  if (__stc_run_%s) ", pi->t->uname);
+                } else if (pi->t && pi->t->interval_ns > 0) {
                     int64_t k = pi->t->interval_ns / tick;
                     uint64_t gg = (uint64_t)gcd64((int64_t)lcm, k);
                     lcm = lcm / gg * (uint64_t)k;

@@ -11,7 +11,7 @@
 static const char *reserved[] = {
     "ACTION", "AND", "ANY", "ARRAY", "AT", "BOOL", "BY", "BYTE", "CASE", "CONFIGURATION",
     "CONSTANT", "DATE", "DATE_AND_TIME", "DINT", "DO", "DT", "DWORD", "ELSE", "ELSIF",
-    "EN", "ENO", "END_ACTION", "END_CASE", "END_CONFIGURATION", "END_FOR", "END_FUNCTION",
+    "END_ACTION", "END_CASE", "END_CONFIGURATION", "END_FOR", "END_FUNCTION",
     "END_FUNCTION_BLOCK", "END_IF", "END_PROGRAM", "END_REPEAT", "END_RESOURCE",
     "END_STRUCT", "END_TYPE", "END_VAR", "END_WHILE", "EXIT", "FALSE", "FOR", "FUNCTION",
     "FUNCTION_BLOCK", "IF", "INT", "INTERVAL", "LINT", "LREAL", "LWORD", "MOD", "NOT", "OF",
@@ -325,6 +325,9 @@ static void lex_location(Lexer *L) {
         if (p + 1 < end && *p == '.' && isdigit((unsigned char)p[1])) p++;
         else break;
     }
+    if (p < end && *p == '*')
+        fatal_at(here(L, s), "partly specified locations like '%.*s*' are not supported by stc: give the full address",
+                 (int)(p - s), s);
     if (!ok || (p < end && ident_char((unsigned char)*p))) {
         while (p < end && (ident_char((unsigned char)*p) || *p == '.')) p++;
         fatal_at(here(L, s), "malformed location '%.*s'", (int)(p - s), s);
@@ -340,6 +343,7 @@ static const char *puncts[] = {
 
 Token *lex(const Source *src, int *count) {
     Lexer L = {src, src->text, src->text + src->len, 1, src->text, {0}};
+    bool warned_single = false;   /* the target-C warning, once per file */
     while (L.p < L.end) {
         const char *p = L.p;
         unsigned char c = (unsigned char)*p;
@@ -364,9 +368,22 @@ Token *lex(const Source *src, int *count) {
                 Token *t = add(&L, TK_PRAGMA, p, p + 2);
                 t->sval = xstrndup(p + 2, (size_t)(e - p - 2));
                 advance_to(&L, e + 2);
-            } else {
-                advance_to(&L, e + 1);    /* { } pragmas: compiler hints, ignored */
+                continue;
             }
+            /* { ... }: matiec copies it into the C as it does {{ ... }}, except
+               its own {enable/disable code generation}, which stc ignores */
+            char *text = xstrndup(p + 1, (size_t)(e - p - 1));
+            if (!strncmp(text, "#include", 8)) fatal_at(here(&L, p), "{#include ...} pragmas are not supported by stc");
+            if (strcmp(text, "enable code generation") && strcmp(text, "disable code generation")) {
+                Token *t = add(&L, TK_PRAGMA, p, p + 1);
+                t->sval = text;
+                t->ival = 1;
+                if (!warned_single) {
+                    warning_at(t->loc, "'{ ... }' pragma copied into the generated C, as matiec does: its text must be C for the target");
+                    warned_single = true;
+                }
+            }
+            advance_to(&L, e + 1);
             continue;
         }
         if (isdigit(c)) { lex_number(&L); continue; }
@@ -400,6 +417,8 @@ Token *lex(const Source *src, int *count) {
             }
         }
         if (!matched) {
+            if (c == '^') fatal_at(here(&L, p), "pointer dereference '^' is not supported by stc");
+            if (c == '?' && p + 1 < L.end && p[1] == '=') fatal_at(here(&L, p), "assignment attempt '?=' is not supported by stc");
             if (c >= 0x20 && c < 0x7f) fatal_at(here(&L, p), "unexpected character '%c'", c);
             fatal_at(here(&L, p), "unexpected byte 0x%02X", c);
         }

@@ -21,6 +21,11 @@ static Token *next(P *p) { Token *t = cur(p); if (t->kind != TK_EOF) p->i++; ret
 
 static bool is_kw(Token *t, const char *kw) { return t->kind == TK_IDENT && !strcmp(t->up, kw); }
 static bool is_p(Token *t, const char *s) { return t->kind == TK_PUNCT && !strcmp(t->up, s); }
+/* A keyword beginning with prefix (END_..., VAR_...): a name that merely
+   starts the same way, like var_out or end_x, is an identifier. */
+static bool kw_prefix(Token *t, const char *prefix) {
+    return t->kind == TK_IDENT && !strncmp(t->up, prefix, strlen(prefix)) && is_reserved(t->up);
+}
 
 static const char *desc(Token *t) {
     if (t->kind == TK_EOF) return "end of file";
@@ -50,11 +55,11 @@ static Token *expect_kw(P *p, const char *kw) {
 static void expect_end(P *p, Token *open, const char *what, const char *end) {
     if (accept_kw(p, end)) return;
     Token *t = cur(p);
-    if (t->kind == TK_EOF || (t->kind == TK_IDENT && (!strncmp(t->up, "END_", 4) ||
+    if (t->kind == TK_EOF || (t->kind == TK_IDENT && (kw_prefix(t, "END_") ||
         !strcmp(t->up, "FUNCTION") || !strcmp(t->up, "FUNCTION_BLOCK") || !strcmp(t->up, "PROGRAM") ||
         !strcmp(t->up, "CONFIGURATION") || !strcmp(t->up, "TYPE") || !strcmp(t->up, "ELSE") ||
         !strcmp(t->up, "ELSIF") || !strcmp(t->up, "UNTIL") || !strcmp(t->up, "VAR") ||
-        !strncmp(t->up, "VAR_", 4) || !strcmp(t->up, "RESOURCE"))))
+        kw_prefix(t, "VAR_") || !strcmp(t->up, "RESOURCE"))))
         fatal_at(open->loc, "%s without %s", what, end);
     expected(p, fmt("'%s'", end));
 }
@@ -64,6 +69,24 @@ static Token *ident(P *p, const char *what) {
     if (t->kind != TK_IDENT) expected(p, what);
     if (is_reserved(t->up)) fatal_at(t->loc, "expected %s, found keyword '%s'", what, t->text);
     return next(p);
+}
+
+/* Constructs stc does not compile, named in the diagnostic. */
+static bool is_one_of(Token *t, const char *const *names) {
+    if (t->kind != TK_IDENT) return false;
+    for (; *names; names++) if (!strcmp(t->up, *names)) return true;
+    return false;
+}
+static const char *const oop_words[] = {"CLASS", "INTERFACE", "NAMESPACE", "METHOD", "PROPERTY", "EXTENDS", "IMPLEMENTS", NULL};
+static const char *const sfc_words[] = {"INITIAL_STEP", "STEP", "TRANSITION", "ACTION", NULL};
+static const char *const il_ops[] = {"LD", "LDN", "ST", "STN", "S", "R", "ANDN", "ORN", "XORN", "CAL", "CALC", "CALCN",
+                                    "JMPC", "JMPCN", "RET", "RETC", "RETCN", NULL};
+static const char *const unsupported_types[] = {"WSTRING", "CHAR", "WCHAR", "LTIME", "LDATE", "LTOD", "LDT",
+                                               "LTIME_OF_DAY", "LDATE_AND_TIME", NULL};
+
+static void unsupported_oop(Token *t) {
+    if (t->kind == TK_IDENT && is_one_of(t, oop_words))
+        fatal_at(t->loc, "object-oriented ST (%s) is not supported by stc", t->up);
 }
 
 static Node *new_node(NodeKind k, Token *t) {
@@ -204,7 +227,11 @@ static Node *primary(P *p) {
             }
             return n;
         }
-        if (is_reserved(t->up)) {
+        bool opfn = (is_kw(t, "AND") || is_kw(t, "OR") || is_kw(t, "XOR") || is_kw(t, "NOT") || is_kw(t, "MOD")) &&
+                    is_p(peek(p, 1), "(");   /* the operator functions AND(a, b), ... */
+        if (is_kw(t, "TIME") && is_p(peek(p, 1), "("))
+            fatal_at(t->loc, "TIME() is CODESYS's clock, not a standard function: stc does not support it");
+        if (is_reserved(t->up) && !opfn) {
             /* type-named conversion calls like INT_TO_REAL are not reserved; these are */
             fatal_at(t->loc, "expected expression, found keyword '%s'", t->text);
         }
@@ -257,7 +284,8 @@ static Node *unary(P *p) {
         if (!strcmp(n->op, "+")) { n->lhs->start = t->loc; return n->lhs; }
         return n;
     }
-    if (is_kw(t, "NOT")) {
+    /* NOT(IN := x) is the function; NOT (x) the operator, with the same meaning */
+    if (is_kw(t, "NOT") && !(is_p(peek(p, 1), "(") && peek(p, 2)->kind == TK_IDENT && is_p(peek(p, 3), ":="))) {
         next(p);
         enter(p);
         Node *n = new_node(N_UNARY, t);
@@ -408,6 +436,7 @@ static TypeSpec *new_spec(TSKind k, Token *t) {
 
 static Node *range(P *p) {
     Token *t = cur(p);
+    if (is_p(t, "*")) fatal_at(t->loc, "variable-length arrays (ARRAY[*]) are not supported by stc");
     Node *r = new_node(N_RANGE, t);
     r->lhs = expr(p);
     expect_p(p, "..");
@@ -454,6 +483,9 @@ static TypeSpec *type_spec(P *p) {
         return s;
     }
     if (t->kind != TK_IDENT) expected(p, "type name");
+    if (is_one_of(t, unsupported_types)) fatal_at(t->loc, "type %s is not supported by stc", t->up);
+    if (is_kw(t, "REF_TO") || is_kw(t, "POINTER") || is_kw(t, "REFERENCE"))
+        fatal_at(t->loc, "pointers and references (%s) are not supported by stc", t->up);
     next(p);
     if (is_p(cur(p), "(")) {                 /* subrange: INT (lo..hi) */
         next(p);
@@ -473,9 +505,10 @@ static TypeSpec *type_spec(P *p) {
 static void var_decls(P *p, Vec *out, VarClass cls, bool constant, bool retain, Token *open, const char *end) {
     for (;;) {
         Token *t = cur(p);
+        if (t->kind == TK_PRAGMA && t->ival) { next(p); continue; }   /* { } hint in a declaration: dropped */
         if (t->kind != TK_IDENT || is_reserved(t->up)) {
             if (is_kw(t, end)) return;
-            if (t->kind == TK_IDENT && (!strncmp(t->up, "END_", 4) || !strncmp(t->up, "VAR", 3) ||
+            if (t->kind == TK_IDENT && (kw_prefix(t, "END_") || !strncmp(t->up, "VAR", 3) ||
                                         is_kw(t, "FUNCTION") || is_kw(t, "FUNCTION_BLOCK") ||
                                         is_kw(t, "PROGRAM")))
                 return;   /* caller reports the missing END_VAR */
@@ -503,6 +536,9 @@ static void var_decls(P *p, Vec *out, VarClass cls, bool constant, bool retain, 
         }
         next(p);
         TypeSpec *spec = type_spec(p);
+        if (is_kw(cur(p), "R_EDGE") || is_kw(cur(p), "F_EDGE"))
+            fatal_at(cur(p)->loc, "edge-detecting inputs (%s) are not supported by stc: use an %s_TRIG", cur(p)->up,
+                     cur(p)->up[0] == 'R' ? "R" : "F");
         Node *init = NULL;
         if (accept_p(p, ":=")) init = init_value(p);
         expect_p(p, ";");
@@ -684,6 +720,16 @@ static Node *statement(P *p) {
         accept_p(p, ";");
         return n;
     }
+    if (is_kw(t, "ACTION")) fatal_at(t->loc, "actions (ACTION ... END_ACTION) are not supported by stc");
+    if (is_one_of(t, sfc_words))
+        fatal_at(t->loc, "Sequential Function Chart (%s) is not supported by stc", t->up);
+    unsupported_oop(t);
+    if (is_kw(t, "CONTINUE") && is_p(peek(p, 1), ";"))
+        fatal_at(t->loc, "CONTINUE is not supported by stc (nor by matiec): put the rest of the loop body under an IF");
+    if (is_kw(t, "JMP") || (t->kind == TK_IDENT && !is_reserved(t->up) && is_p(peek(p, 1), ":") && !is_p(peek(p, 2), "=")))
+        fatal_at(t->loc, "jumps and labels are not supported by stc");
+    if (is_one_of(t, il_ops) && (peek(p, 1)->kind == TK_IDENT || peek(p, 1)->kind == TK_INT || peek(p, 1)->kind == TK_LOCATION))
+        fatal_at(t->loc, "Instruction List (IL) is not supported by stc: it compiles Structured Text");
     if (is_kw(t, "EXIT")) { next(p); expect_p(p, ";"); return new_node(S_EXIT, t); }
     if (is_kw(t, "RETURN")) { next(p); expect_p(p, ";"); return new_node(S_RETURN, t); }
     if (t->kind == TK_IDENT && !is_reserved(t->up)) {
@@ -725,9 +771,9 @@ static bool stmt_stop(P *p) {
     Token *t = cur(p);
     if (t->kind == TK_EOF) return true;
     if (t->kind != TK_IDENT) return false;
-    return !strncmp(t->up, "END_", 4) || is_kw(t, "ELSE") || is_kw(t, "ELSIF") || is_kw(t, "UNTIL") ||
+    return kw_prefix(t, "END_") || is_kw(t, "ELSE") || is_kw(t, "ELSIF") || is_kw(t, "UNTIL") ||
            is_kw(t, "FUNCTION") || is_kw(t, "FUNCTION_BLOCK") || is_kw(t, "PROGRAM") ||
-           is_kw(t, "CONFIGURATION") || is_kw(t, "TYPE") || is_kw(t, "VAR") || !strncmp(t->up, "VAR_", 4);
+           is_kw(t, "CONFIGURATION") || is_kw(t, "TYPE") || is_kw(t, "VAR") || kw_prefix(t, "VAR_");
 }
 
 static void stmts(P *p, Vec *out, bool in_case) {
@@ -752,11 +798,16 @@ static void pou(P *p) {
     u->uname = name->up;
     u->loc = name->loc;
     u->from_lib = p->lib;
+    unsupported_oop(cur(p));
     if (u->kind == POU_FUNCTION) {
         expect_p(p, ":");
         u->ret = type_spec(p);
     }
-    while (var_block(p, &u->vars, false)) {}
+    for (;;) {   /* a { } pragma between VAR blocks is a declaration hint: dropped */
+        if (cur(p)->kind == TK_PRAGMA && cur(p)->ival && peek(p, 1)->kind == TK_IDENT &&
+            (is_kw(peek(p, 1), "VAR") || kw_prefix(peek(p, 1), "VAR_"))) { next(p); continue; }
+        if (!var_block(p, &u->vars, false)) break;
+    }
     stmt_list(p, &u->body);
     expect_end(p, t, what, end);
     vec_push(&p->u->pous, u);
@@ -887,6 +938,10 @@ void parse_unit(Unit *u, const Source *src, bool from_lib) {
         else if (is_kw(t, "TYPE")) type_block(&p);
         else if (is_kw(t, "CONFIGURATION")) configuration(&p);
         else if (is_p(t, ";")) next(&p);
-        else expected(&p, "FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
+        else {
+            unsupported_oop(t);
+            if (is_one_of(t, sfc_words)) fatal_at(t->loc, "Sequential Function Chart (%s) is not supported by stc", t->up);
+            expected(&p, "FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
+        }
     }
 }

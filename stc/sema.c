@@ -101,6 +101,42 @@ static Sym *find(Vec *v, const char *uname) {
     return NULL;
 }
 
+/* ---- "did you mean": the declared name nearest to a misspelt one ---- */
+typedef struct { const char *want; const char *best; int dist; } Near;
+
+static int edit_distance(const char *a, const char *b) {   /* upper-case names */
+    size_t n = strlen(a), m = strlen(b);
+    if (n > 63 || m > 63) return 99;
+    int row[64], prev[64];
+    for (size_t j = 0; j <= m; j++) prev[j] = (int)j;
+    for (size_t i = 1; i <= n; i++) {
+        row[0] = (int)i;
+        for (size_t j = 1; j <= m; j++) {
+            int sub = prev[j - 1] + (a[i - 1] != b[j - 1]);
+            int del = prev[j] + 1, ins = row[j - 1] + 1;
+            row[j] = sub < del ? (sub < ins ? sub : ins) : (del < ins ? del : ins);
+        }
+        memcpy(prev, row, sizeof(int) * (m + 1));
+    }
+    return prev[m];
+}
+
+static void near_name(Near *nr, const char *name) {
+    char *up = upcase(name);
+    if (!strcmp(up, nr->want)) return;
+    int d = edit_distance(nr->want, up);
+    size_t len = strlen(nr->want);
+    int limit = len <= 2 ? 0 : len <= 4 ? 1 : len <= 7 ? 2 : 3;   /* one- and two-letter names: no guess */
+    if (d > 0 && d <= limit && (!nr->best || d < nr->dist)) { nr->best = name; nr->dist = d; }
+}
+
+static void near_syms(Near *nr, Vec *v) {
+    for (int i = 0; v && i < v->n; i++) near_name(nr, ((Sym *)v->v[i])->name);
+}
+
+/* "; did you mean 'x'?" or "" */
+static const char *near_hint(Near *nr) { return nr->best ? fmt("; did you mean '%s'?", nr->best) : ""; }
+
 static Sym *new_sym(SymKind k, char *name, char *uname, Loc loc) {
     Sym *s = xalloc(sizeof *s);
     s->kind = k;
@@ -201,7 +237,12 @@ static Type *named_type(Ctx *c, const char *uname, Loc loc, const char *spelled)
     Sym *p = find(&c->pous, uname);
     if (p && p->pou->kind != POU_FUNCTION) { p->pou->used = true; return p->pou->type; }
     if (p) { error_at(loc, "'%s' is a function, not a type", spelled); return err_type(); }
-    error_at(loc, "unknown type '%s'", spelled);
+    Near nr = {uname, NULL, 0};
+    for (int k = 0; k <= T_STRING; k++) near_name(&nr, ty_prim[k]->name);
+    near_syms(&nr, &c->types);
+    for (int i = 0; i < c->pous.n; i++)
+        if (((Sym *)c->pous.v[i])->pou->kind == POU_FB) near_name(&nr, ((Sym *)c->pous.v[i])->name);
+    error_at(loc, "unknown type '%s'%s", spelled, near_hint(&nr));
     return err_type();
 }
 
@@ -391,6 +432,11 @@ static bool lit_fits(Node *n, Type *t, bool report) {
         return true;
     }
     case N_CALL:
+        if (n->opx) {
+            if (!lit_fits(n->opx, t, report)) return false;
+            n->ty = t;
+            return true;
+        }
         for (int i = 0; i < n->list.n; i++) {
             Node *a = n->list.v[i];
             if (a->lhs && is_lit(a->lhs->ty) && !lit_fits(a->lhs, t, report)) return false;
@@ -443,9 +489,48 @@ static Type *check(Ctx *c, Node *n, Type *want);
 static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb);
 static Type *check_builtin(Ctx *c, Node *n, Type *want);
 
+/* EN and ENO of a function or function block (IEC 61131-3 2.5.1.2): every one
+   has them, so they appear when a call or the body first names them, as a
+   BOOL input EN (initially TRUE) and a BOOL output ENO. */
+static bool is_en_eno(const char *uname) { return !strcmp(uname, "EN") || !strcmp(uname, "ENO"); }
+
+static Sym *implicit_flag(Pou *p, char *name, VarClass cls) {
+    Sym *s = new_sym(SK_VAR, name, name, p->loc);
+    VarDecl *d = xalloc(sizeof *d);
+    d->name = d->uname = name;
+    d->loc = p->loc;
+    d->cls = cls;
+    if (cls == V_INPUT) {
+        Node *t = xalloc(sizeof *t);
+        t->kind = N_BOOL;
+        t->ival = 1;
+        t->ty = ty_prim[T_BOOL];
+        t->loc = t->start = p->loc;
+        d->init = t;
+    }
+    s->decl = d;
+    s->cls = cls;
+    s->type = ty_prim[T_BOOL];
+    s->pou = p;
+    s->in_function = p->kind == POU_FUNCTION;
+    s->implicit = true;
+    vec_push(&p->syms, s);
+    return s;
+}
+
+static void need_en_eno(Pou *p) {
+    if (p->kind == POU_PROGRAM) return;
+    if (!p->en) p->en = implicit_flag(p, "EN", V_INPUT);
+    if (!p->eno) p->eno = implicit_flag(p, "ENO", V_OUTPUT);
+}
+
 static Sym *lookup_var(Ctx *c, const char *uname) {
     Sym *s = find(c->scope, uname);
     if (s) return s;
+    if (c->pou && c->pou->kind != POU_PROGRAM && is_en_eno(uname)) {
+        need_en_eno(c->pou);
+        return find(c->scope, uname);
+    }
     if (!c->pou) {
         if ((s = find(c->gscope[0], uname))) return s;
         if ((s = find(c->gscope[1], uname))) return s;
@@ -485,7 +570,11 @@ static Type *check_ident(Ctx *c, Node *n, Type *want) {
         return err_type();
     }
     if (type_sym(c, n->uname)) { error_at(n->loc, "'%s' is a type, not a variable", n->name); return err_type(); }
-    error_at(n->loc, "undeclared identifier '%s'", n->name);
+    Near nr = {n->uname, NULL, 0};
+    near_syms(&nr, c->scope);
+    if (!c->pou) { near_syms(&nr, c->gscope[0]); near_syms(&nr, c->gscope[1]); }
+    near_syms(&nr, &c->enumvals);
+    error_at(n->loc, "undeclared identifier '%s'%s", n->name, near_hint(&nr));
     return err_type();
 }
 
@@ -538,7 +627,12 @@ static Type *check_member(Ctx *c, Node *n) {
         }
     } else if (t->kind == T_FB) {
         Sym *m = find(&t->pou->syms, n->uname);
-        if (m && (m->cls == V_INPUT || m->cls == V_OUTPUT)) { n->sym = m; return m->type; }
+        if (!m && is_en_eno(n->uname) && t->pou->kind == POU_FB) {
+            need_en_eno(t->pou);
+            m = find(&t->pou->syms, n->uname);
+        }
+        /* an in-out reads the variable the last call connected */
+        if (m && (m->cls == V_INPUT || m->cls == V_OUTPUT || m->cls == V_IN_OUT)) { n->sym = m; return m->type; }
         if (m) {
             error_at(n->loc, "'%s' is an internal variable of '%s', not accessible from outside", n->name, t->pou->name);
             return err_type();
@@ -548,7 +642,15 @@ static Type *check_member(Ctx *c, Node *n) {
                  t->name);
         return err_type();
     }
-    error_at(n->loc, "no member '%s' in '%s'", n->name, t->name);
+    Near nr = {n->uname, NULL, 0};
+    if (t->kind == T_STRUCT)
+        for (int i = 0; i < t->fields.n; i++) near_name(&nr, ((Field *)t->fields.v[i])->name);
+    else
+        for (int i = 0; i < t->pou->syms.n; i++) {
+            Sym *m = t->pou->syms.v[i];
+            if (m->cls == V_INPUT || m->cls == V_OUTPUT || m->cls == V_IN_OUT) near_name(&nr, m->name);
+        }
+    error_at(n->loc, "no member '%s' in '%s'%s", n->name, t->name, near_hint(&nr));
     return err_type();
 }
 
@@ -596,8 +698,11 @@ static OpClass op_class(const char *op) {
     return OP_CMP;
 }
 
+/* the operator as the user wrote it: '+' or ADD */
+static const char *opname(Node *n) { return n->name ? n->name : n->op; }
+
 static Type *mismatch(Node *n, Type *a, Type *b) {
-    error_at(n->loc, "type mismatch: %s and %s in '%s'", type_name(a), type_name(b), n->op);
+    error_at(n->loc, "type mismatch: %s and %s in '%s'", type_name(a), type_name(b), opname(n));
     return err_type();
 }
 
@@ -677,7 +782,7 @@ static Type *check_binary(Ctx *c, Node *n, Type *want) {
     Type *ct = canon(t);
     switch (k) {
     case OP_ARITH:
-        if (!is_num(ct)) { error_at(n->loc, "'%s' is not defined for %s", n->op, t->name); return err_type(); }
+        if (!is_num(ct)) { error_at(n->loc, "'%s' is not defined for %s", opname(n), t->name); return err_type(); }
         return t;
     case OP_MOD:
         if (!is_int(ct)) { error_at(n->loc, "'MOD' needs integers, not %s", t->name); return err_type(); }
@@ -685,21 +790,21 @@ static Type *check_binary(Ctx *c, Node *n, Type *want) {
     case OP_LOGIC:
         if (ct->kind != T_BOOL && !is_bit(ct)) {
             if (is_lit(ct) && wop == NULL) { default_lit(n->lhs); default_lit(n->rhs); }
-            error_at(n->loc, "'%s' needs BOOL or bit strings, not %s", n->op, t->name);
+            error_at(n->loc, "'%s' needs BOOL or bit strings, not %s", opname(n), t->name);
             return err_type();
         }
         return t;
     case OP_CMP:
         if (is_lit(ct)) { default_lit(n->lhs); default_lit(n->rhs); ct = canon(n->lhs->ty); }
         if (!is_num(ct) && !is_bit(ct) && !is_timeish(ct) && ct->kind != T_STRING && ct->kind != T_BOOL) {
-            error_at(n->loc, "'%s' cannot compare %s", n->op, t->name);
+            error_at(n->loc, "'%s' cannot compare %s", opname(n), t->name);
             return err_type();
         }
         return ty_prim[T_BOOL];
     case OP_EQ:
         if (is_lit(ct)) { default_lit(n->lhs); default_lit(n->rhs); ct = canon(n->lhs->ty); }
         if (!is_elementary(ct) && ct->kind != T_ENUM) {
-            error_at(n->loc, "'%s' cannot compare %s", n->op, t->name);
+            error_at(n->loc, "'%s' cannot compare %s", opname(n), t->name);
             return err_type();
         }
         return ty_prim[T_BOOL];
@@ -745,6 +850,12 @@ static void check_writable(Ctx *c, Node *n) {
     if (r->loop_locked) { error_at(n->start, "cannot assign to FOR variable '%s' inside its loop", r->name); return; }
     /* writing an instance's member from outside: inputs only */
     for (Node *m = n; m->kind == N_MEMBER || m->kind == N_INDEX; m = m->lhs) {
+        if (m->kind == N_MEMBER && m->sym && m->sym->kind == SK_VAR && m->sym->cls == V_IN_OUT) {
+            Node *inst = m->lhs;
+            error_at(n->start, "cannot assign to in-out '%s' of instance '%s': connect it in a call", m->name,
+                     inst->kind == N_IDENT ? inst->name : "instance");
+            return;
+        }
         if (m->kind == N_MEMBER && m->sym && m->sym->kind == SK_VAR && m->sym->cls == V_OUTPUT) {
             Node *inst = m->lhs;
             const char *iname = inst->kind == N_IDENT ? inst->name : "instance";
@@ -755,6 +866,16 @@ static void check_writable(Ctx *c, Node *n) {
     if (c->pou && c->pou->kind == POU_FUNCTION && r->cls == V_INPUT && n->kind == N_IDENT) return;
 }
 
+/* A call naming EN or ENO gives the callee both. */
+static void uses_en_eno(Node *call, Pou *p) {
+    for (int i = 0; i < call->list.n; i++) {
+        Node *a = call->list.v[i];
+        if (a->uname && is_en_eno(a->uname)) need_en_eno(p);
+    }
+}
+
+static void near_builtins(Near *nr);
+
 static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
     if (n->lhs) {      /* a[i](...): the instance is an expression */
         Type *it = check(c, n->lhs, NULL);
@@ -762,6 +883,7 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
         if (canon(it)->kind != T_FB) { error_at(n->lhs->start, "this is not a function block instance, it is %s", type_name(it)); return err_type(); }
         n->callee = canon(it)->pou;
         n->name = n->callee->name;
+        uses_en_eno(n, n->callee);
         check_call_args(c, n, n->callee, true);
         return ty_prim[T_VOID];
     }
@@ -778,6 +900,7 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
         }
         n->sym = v;
         n->callee = t->pou;
+        uses_en_eno(n, t->pou);
         check_call_args(c, n, t->pou, true);
         return ty_prim[T_VOID];
     }
@@ -791,13 +914,25 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
         p->pou->used = true;
         n->callee = p->pou;
         if (c->pou) vec_push(&c->pou->calls, p->pou);
+        uses_en_eno(n, p->pou);
         check_call_args(c, n, p->pou, false);
         return p->pou->rettype;
     }
     Type *b = check_builtin(c, n, want);
     if (b) return b;
-    if (v) error_at(n->loc, "'%s' is not a function", n->name);
-    else error_at(n->loc, "'%s' is not a function", n->name);
+    const char *unsupported[] = {"LEFT", "RIGHT", "MID", "INSERT", "DELETE", "REPLACE", "FIND", NULL};
+    for (int i = 0; unsupported[i]; i++)
+        if (!strcmp(unsupported[i], n->uname)) {
+            error_at(n->loc, "the standard function %s is not supported by stc", n->uname);
+            return err_type();
+        }
+    if (v) { error_at(n->loc, "'%s' is not a function", n->name); return err_type(); }
+    Near nr = {n->uname, NULL, 0};
+    for (int i = 0; i < c->pous.n; i++)
+        if (((Sym *)c->pous.v[i])->pou->kind == POU_FUNCTION) near_name(&nr, ((Sym *)c->pous.v[i])->name);
+    near_builtins(&nr);
+    near_syms(&nr, c->scope);
+    error_at(n->loc, "'%s' is not a function%s", n->name, near_hint(&nr));
     return err_type();
 }
 
@@ -812,7 +947,7 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
     bool *given = xalloc(sizeof(bool) * (size_t)(params.n + 1));
     int ninputs = 0;
     for (int i = 0; i < params.n; i++)
-        if (((Sym *)params.v[i])->cls != V_OUTPUT) ninputs++;
+        if (((Sym *)params.v[i])->cls != V_OUTPUT && !((Sym *)params.v[i])->implicit) ninputs++;
     for (int i = 0; i < call->list.n; i++) {
         Node *a = call->list.v[i];
         bool f = a->name != NULL;
@@ -830,7 +965,7 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
         }
         for (int i = 0; i < params.n && k < call->list.n; i++) {
             Sym *s = params.v[i];
-            if (s->cls == V_OUTPUT) continue;
+            if (s->cls == V_OUTPUT || s->implicit) continue;
             Node *a = call->list.v[k++];
             a->sym = s;
             a->name = s->name;
@@ -844,7 +979,9 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
         for (int j = 0; j < params.n; j++)
             if (!strcmp(((Sym *)params.v[j])->uname, a->uname)) pi = j;
         if (pi < 0) {
-            error_at(a->loc, "unknown parameter '%s' for '%s'", a->name, p->name);
+            Near nr = {a->uname, NULL, 0};
+            near_syms(&nr, &params);
+            error_at(a->loc, "unknown parameter '%s' for '%s'%s", a->name, p->name, near_hint(&nr));
             if (a->lhs) check(c, a->lhs, NULL);
             continue;
         }
@@ -880,7 +1017,8 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
     int missing = 0;
     for (int i = 0; i < params.n; i++) {
         Sym *s = params.v[i];
-        bool needed = s->cls == V_IN_OUT || (!is_fb && s->cls == V_INPUT && !s->decl->init);
+        /* a formal call may leave inputs out: they take their initial value */
+        bool needed = s->cls == V_IN_OUT || (formal == 0 && !is_fb && s->cls == V_INPUT && !s->decl->init && !s->implicit);
         if (!needed || given[i]) continue;
         if (formal == 0 && !missing++)
             error_at(call->loc, "'%s' expects %d argument%s, got %d", p->name, ninputs, ninputs == 1 ? "" : "s",
@@ -891,6 +1029,8 @@ static void check_call_args(Ctx *c, Node *call, Pou *p, bool is_fb) {
 }
 
 /* ---- builtin functions ---- */
+/* nargs < 0: extensible, at least -nargs inputs IN1, IN2, ... (MUX: K, IN0, ...);
+   the operator functions' operators are in opfns */
 static const struct { const char *name; int id; int nargs; const char *pnames[3]; } builtins[] = {
     {"TRUNC", B_TRUNC, 1, {"IN"}}, {"ABS", B_ABS, 1, {"IN"}}, {"SQRT", B_SQRT, 1, {"IN"}},
     {"LN", B_LN, 1, {"IN"}}, {"LOG", B_LOG, 1, {"IN"}}, {"EXP", B_EXP, 1, {"IN"}},
@@ -901,8 +1041,30 @@ static const struct { const char *name; int id; int nargs; const char *pnames[3]
     {"MUX", B_MUX, -3, {0}}, {"MOVE", B_MOVE, 1, {"IN"}}, {"SHL", B_SHL, 2, {"IN", "N"}},
     {"SHR", B_SHR, 2, {"IN", "N"}}, {"ROL", B_ROL, 2, {"IN", "N"}}, {"ROR", B_ROR, 2, {"IN", "N"}},
     {"LEN", B_LEN, 1, {"IN"}},
+    /* IEC 61131-3 tables 24, 26, 28: the operators as functions (opfns) */
+    {"ADD", B_OP, -2, {0}}, {"MUL", B_OP, -2, {0}}, {"SUB", B_OP, 2, {"IN1", "IN2"}},
+    {"DIV", B_DIV, 2, {"IN1", "IN2"}}, {"MOD", B_OP, 2, {"IN1", "IN2"}},
+    {"AND", B_OP, -2, {0}}, {"OR", B_OP, -2, {0}}, {"XOR", B_OP, -2, {0}}, {"NOT", B_OP, 1, {"IN"}},
+    {"GT", B_OP, -2, {0}}, {"GE", B_OP, -2, {0}}, {"EQ", B_OP, -2, {0}},
+    {"LE", B_OP, -2, {0}}, {"LT", B_OP, -2, {0}}, {"NE", B_OP, 2, {"IN1", "IN2"}},
+    {"CONCAT", B_CONCAT, -2, {0}},
     {NULL, 0, 0, {0}},
 };
+
+static const char *const opfns[][2] = {
+    {"ADD", "+"}, {"MUL", "*"}, {"SUB", "-"}, {"DIV", "/"}, {"MOD", "MOD"}, {"AND", "AND"}, {"OR", "OR"},
+    {"XOR", "XOR"}, {"NOT", "NOT"}, {"GT", ">"}, {"GE", ">="}, {"EQ", "="}, {"LE", "<="}, {"LT", "<"}, {"NE", "<>"},
+};
+
+static void near_builtins(Near *nr) {
+    for (int i = 0; builtins[i].name; i++) near_name(nr, builtins[i].name);
+}
+
+static const char *opfn_op(const char *uname) {
+    for (size_t i = 0; i < sizeof opfns / sizeof opfns[0]; i++)
+        if (!strcmp(opfns[i][0], uname)) return opfns[i][1];
+    return NULL;
+}
 
 /* The elementary type named by the first len chars of s, or NULL. */
 static Type *prim_named(const char *s, size_t len) {
@@ -914,9 +1076,7 @@ static Type *prim_named(const char *s, size_t len) {
 }
 
 /* Put formal builtin arguments in positional order. */
-static bool order_builtin_args(Node *n, int id) {
-    int nb = -1;
-    for (int i = 0; builtins[i].name; i++) if (builtins[i].id == id) nb = i;
+static bool order_builtin_args(Node *n, int id, int nb) {
     bool formal = n->list.n && ((Node *)n->list.v[0])->name;
     if (!formal) {
         for (int i = 0; i < n->list.n; i++)
@@ -924,8 +1084,10 @@ static bool order_builtin_args(Node *n, int id) {
         return true;
     }
     int cnt = n->list.n;
+    bool fixed = nb >= 0 && builtins[nb].nargs > 1 && builtins[nb].nargs >= cnt;
+    if (fixed) cnt = builtins[nb].nargs;
     Node **ord = xalloc(sizeof(Node *) * (size_t)(cnt + 1));
-    for (int i = 0; i < cnt; i++) {
+    for (int i = 0; i < n->list.n; i++) {
         Node *a = n->list.v[i];
         if (!a->name || a->is_out) { error_at(a->loc, "cannot mix formal (name := value) and positional arguments"); return false; }
         int pos = -1;
@@ -946,9 +1108,13 @@ static bool order_builtin_args(Node *n, int id) {
         ord[pos] = a;
     }
     for (int i = 0; i < cnt; i++) {
-        if (!ord[i]) { error_at(n->loc, "missing parameter for '%s'", n->name); return false; }
-        n->list.v[i] = ord[i];
+        if (!ord[i]) {
+            if (fixed) error_at(n->loc, "missing parameter '%s' for '%s'", builtins[nb].pnames[i], n->name);
+            else error_at(n->loc, "missing parameter for '%s'", n->name);
+            return false;
+        }
     }
+    for (int i = 0; i < cnt; i++) n->list.v[i] = ord[i];
     return true;
 }
 
@@ -987,7 +1153,114 @@ static Type *generic_args(Ctx *c, Node *n, int from, Type *want) {
     return t;
 }
 
+/* EN := and ENO => of a standard function call leave its argument list. */
+static bool split_en_eno(Node *n) {
+    int k = 0;
+    for (int i = 0; i < n->list.n; i++) {
+        Node *a = n->list.v[i];
+        if (a->uname && !strcmp(a->uname, "EN")) {
+            if (a->is_out) { error_at(a->loc, "'EN' is not an output of '%s'", n->name); return false; }
+            n->en = a->lhs;
+            continue;
+        }
+        if (a->uname && !strcmp(a->uname, "ENO")) {
+            if (!a->is_out) { error_at(a->loc, "cannot connect output 'ENO' with ':=': use '=>'"); return false; }
+            if (a->negated) { error_at(a->loc, "negated output connections are not supported"); return false; }
+            n->eno = a;
+            continue;
+        }
+        n->list.v[k++] = a;
+    }
+    n->list.n = k;
+    for (int i = 0; (n->en || n->eno) && i < k; i++)   /* EN/ENO make a call formal (matiec too) */
+        if (!((Node *)n->list.v[i])->name) {
+            error_at(((Node *)n->list.v[i])->loc, "cannot mix formal (name := value) and positional arguments");
+            return false;
+        }
+    return true;
+}
+
+static void check_en_eno(Ctx *c, Node *n) {
+    if (n->en) {
+        check(c, n->en, ty_prim[T_BOOL]);
+        check_transfer(ty_prim[T_BOOL], n->en, "type mismatch: parameter '%s' of '%s' expects %4$s, got %3$s", "EN", n->name);
+    }
+    if (n->eno && n->eno->lhs) {
+        Type *t = check(c, n->eno->lhs, ty_prim[T_BOOL]);
+        if (is_err(t)) return;
+        check_writable(c, n->eno->lhs);
+        if (canon(t)->kind != T_BOOL)
+            error_at(n->eno->lhs->start, "type mismatch: output 'ENO' of '%s' is BOOL, its target %s", n->name, type_name(t));
+    }
+}
+
+static bool has_call(Node *n) {
+    if (!n) return false;
+    if (n->kind == N_CALL) return true;
+    if (has_call(n->lhs) || has_call(n->rhs)) return true;
+    for (int i = 0; i < n->list.n; i++) if (has_call(n->list.v[i])) return true;
+    return false;
+}
+
+static Node *clone_expr(Node *n) {
+    if (!n) return NULL;
+    Node *x = xalloc(sizeof *x);
+    *x = *n;
+    x->lhs = clone_expr(n->lhs);
+    x->rhs = clone_expr(n->rhs);
+    x->list = (Vec){0};
+    for (int i = 0; i < n->list.n; i++) vec_push(&x->list, clone_expr(n->list.v[i]));
+    return x;
+}
+
+static Node *op_node(Node *call, const char *op, Node *l, Node *r) {
+    Node *x = xalloc(sizeof *x);
+    x->kind = r ? N_BINARY : N_UNARY;
+    x->loc = call->loc;
+    x->start = l->start;
+    x->op = op;
+    x->name = call->name;    /* diagnostics name the function, not the operator */
+    x->lhs = l;
+    x->rhs = r;
+    return x;
+}
+
+/* ADD(a, b, c) is (a + b) + c; GT(a, b, c) is a > b AND b > c (IEC 61131-3
+   tables 24 and 28); NOT(a) is NOT a. The call keeps the operator tree. */
+static Type *operator_function(Ctx *c, Node *n, const char *op, Type *want) {
+    Node *x;
+    bool cmp = !strcmp(op, ">") || !strcmp(op, ">=") || !strcmp(op, "=") || !strcmp(op, "<=") || !strcmp(op, "<");
+    if (!strcmp(op, "NOT")) {
+        x = op_node(n, op, arg(n, 0), NULL);
+    } else if (cmp && n->list.n > 2) {
+        for (int i = 1; i + 1 < n->list.n; i++)
+            if (has_call(arg(n, i))) {
+                error_at(arg(n, i)->start, "'%s' with more than two inputs compares each middle input twice: "
+                         "a function call there is not supported, give it a variable", n->name);
+                return err_type();
+            }
+        x = NULL;
+        for (int i = 0; i + 1 < n->list.n; i++) {
+            Node *pair = op_node(n, op, i ? clone_expr(arg(n, i)) : arg(n, i), arg(n, i + 1));
+            x = x ? op_node(n, "AND", x, pair) : pair;
+        }
+    } else {
+        x = arg(n, 0);
+        for (int i = 1; i < n->list.n; i++) x = op_node(n, op, x, arg(n, i));
+    }
+    n->opx = x;
+    return check(c, x, want);
+}
+
+static Type *builtin_value(Ctx *c, Node *n, Type *want);
+
 static Type *check_builtin(Ctx *c, Node *n, Type *want) {
+    Type *t = builtin_value(c, n, want);
+    if (t && !is_err(t)) check_en_eno(c, n);
+    return t;
+}
+
+static Type *builtin_value(Ctx *c, Node *n, Type *want) {
     int id = 0, nb = -1;
     Type *from = NULL, *to = NULL;
     const char *us = strstr(n->uname, "_TO_");
@@ -1001,7 +1274,7 @@ static Type *check_builtin(Ctx *c, Node *n, Type *want) {
             if (!strcmp(builtins[i].name, n->uname)) { id = builtins[i].id; nb = i; }
     if (!id) return NULL;
     n->builtin = id;
-    if (!order_builtin_args(n, id)) return err_type();
+    if (!split_en_eno(n) || !order_builtin_args(n, id, nb)) return err_type();
     int want_n = id == B_CONV ? 1 : builtins[nb].nargs;
     if ((want_n > 0 && n->list.n != want_n) || (want_n < 0 && n->list.n < -want_n)) {
         if (want_n > 0)
@@ -1075,6 +1348,13 @@ static Type *check_builtin(Ctx *c, Node *n, Type *want) {
         if (!is_err(t) && !is_elementary(t)) { error_at(n->loc, "'MUX' supports elementary types only"); return err_type(); }
         return t;
     }
+    case B_CONCAT:
+        t = generic_args(c, n, 0, want);
+        if (!is_err(t) && canon(t)->kind != T_STRING) {
+            error_at(n->loc, "'CONCAT' joins strings, not %s", type_name(t));
+            return err_type();
+        }
+        return t;
     case B_MAX: case B_MIN: case B_LIMIT:
         t = generic_args(c, n, 0, want);
         if (!is_err(t) && !is_num(t) && !is_bit(t) && !is_timeish(t)) {
@@ -1093,6 +1373,13 @@ static Type *check_builtin(Ctx *c, Node *n, Type *want) {
         if (!is_int(s->ty)) { error_at(s->start, "type mismatch: parameter 'N' of '%s' expects ANY_INT, got %s", n->name, type_name(s->ty)); return err_type(); }
         return t;
     }
+    case B_OP: case B_DIV:
+        t = operator_function(c, n, opfn_op(n->uname), want);
+        if (id == B_DIV && !is_err(t) && !is_num(t)) {
+            error_at(n->loc, "'DIV' needs numbers, not %s", type_name(t));
+            return err_type();
+        }
+        return t;
     case B_LEN: {
         Node *a = arg(n, 0);
         t = check(c, a, ty_prim[T_STRING]);
@@ -1397,6 +1684,16 @@ static Sym *declare_var(Ctx *c, Vec *scope, VarDecl *d, Pou *p) {
         error_at(d->loc, "a function cannot hold a function block instance");
     if (canon(s->type)->kind == T_FB && (d->cls == V_INPUT || d->cls == V_OUTPUT))
         error_at(d->loc, "function block instances as inputs or outputs are not supported");
+    if (is_en_eno(d->uname)) {   /* declared out loud, as matiec allows: the same flag */
+        bool en = !strcmp(d->uname, "EN");
+        if (!p || p->kind == POU_PROGRAM || d->cls != (en ? V_INPUT : V_OUTPUT) || canon(s->type)->kind != T_BOOL) {
+            error_at(d->loc, "'%s' is the %s of every function and function block: declare it only there, as %s %s : BOOL",
+                     d->name, en ? "enable input" : "enable output", en ? "VAR_INPUT" : "VAR_OUTPUT", d->uname);
+            return NULL;
+        }
+        if (en) p->en = s;
+        else p->eno = s;
+    }
     vec_push(scope, s);
     return s;
 }
@@ -1482,7 +1779,17 @@ static void check_config(Ctx *c, Config *cf) {
             Task *t = res->tasks.v[i];
             for (int j = 0; j < i; j++)
                 if (!strcmp(((Task *)res->tasks.v[j])->uname, t->uname)) error_at(t->loc, "duplicate declaration of '%s'", t->name);
-            if (t->single) error_at(t->single->start, "SINGLE tasks are not supported");
+            if (t->single) {   /* runs on the rising edge of a global BOOL (matiec: an R_TRIG per task) */
+                c->gscope[1] = &cf->gsyms;
+                Type *st = t->single->kind == N_IDENT ? check(c, t->single, ty_prim[T_BOOL]) : NULL;
+                c->gscope[1] = NULL;
+                if (t->single->kind != N_IDENT || (!is_err(st) && (!t->single->sym || !t->single->sym->is_global)))
+                    error_at(t->single->start, "task SINGLE must name a global BOOL variable");
+                else if (!is_err(st) && canon(st)->kind != T_BOOL)
+                    error_at(t->single->start, "task SINGLE must be BOOL, not %s", type_name(st));
+                t->interval_ns = 0;   /* SINGLE wins over INTERVAL, as in matiec */
+                continue;
+            }
             if (!t->interval) { error_at(t->loc, "task '%s' needs an INTERVAL", t->name); continue; }
             Type *it = check(c, t->interval, ty_prim[T_TIME]);
             if (is_err(it)) continue;
@@ -1506,11 +1813,18 @@ static void check_config(Ctx *c, Config *cf) {
             if (pi->task) {
                 for (int j = 0; j < res->tasks.n; j++)
                     if (!strcmp(((Task *)res->tasks.v[j])->uname, pi->task)) pi->t = res->tasks.v[j];
-                if (!pi->t) error_at(pi->taskloc, "undeclared task '%s'", pi->task);
+                if (!pi->t) {
+                    Near nr = {pi->task, NULL, 0};
+                    for (int j = 0; j < res->tasks.n; j++) near_name(&nr, ((Task *)res->tasks.v[j])->name);
+                    error_at(pi->taskloc, "undeclared task '%s'%s", pi->task, near_hint(&nr));
+                }
             }
             Sym *ps = find(&c->pous, pi->pou);
             if (!ps || ps->pou->kind != POU_PROGRAM) {
-                error_at(pi->pouloc, ps ? "'%s' is not a PROGRAM" : "unknown program '%s'", pi->pou);
+                Near nr = {pi->pou, NULL, 0};
+                for (int j = 0; !ps && j < c->pous.n; j++)
+                    if (((Sym *)c->pous.v[j])->pou->kind == POU_PROGRAM) near_name(&nr, ((Sym *)c->pous.v[j])->name);
+                error_at(pi->pouloc, ps ? "'%s' is not a PROGRAM%s" : "unknown program '%s'%s", pi->pou, near_hint(&nr));
                 continue;
             }
             pi->p = ps->pou;

@@ -34,7 +34,9 @@ typedef struct { const Source *src; int line, col; } Loc;
 
 /* Print "file:line:col: error: msg", the source line and a caret. */
 void error_at(Loc loc, const char *f, ...) __attribute__((format(printf, 2, 3)));
-/* Same, then exit(1). */
+/* "file:line:col: warning: msg" and the line; compilation goes on. */
+void warning_at(Loc loc, const char *f, ...) __attribute__((format(printf, 2, 3)));
+/* Same as error_at, then exit(1). */
 _Noreturn void fatal_at(Loc loc, const char *f, ...) __attribute__((format(printf, 2, 3)));
 extern int error_count;
 /* When set, fatal errors jump here instead of exiting (for embedding and fuzzing). */
@@ -51,7 +53,7 @@ typedef enum {
     TK_TIME,     /* T#, TOD#, D#, DT# literal: tval (ns), tkind */
     TK_PUNCT,    /* operator or punctuation: up holds it */
     TK_LOCATION, /* %IX0.1 etc: text */
-    TK_PRAGMA,   /* {{ C code }}: sval */
+    TK_PRAGMA,   /* {{ C code }} or { C code }: sval; ival 1 for the single-brace form */
     TK_EOF,
 } TokKind;
 
@@ -121,6 +123,8 @@ struct Node {
     Pou *callee;      /* called POU (user function or FB type) */
     int builtin;      /* builtin function id, when > 0 */
     Type *conv_from;  /* builtin conversions and generic functions: operand type */
+    Node *en, *eno;   /* standard function calls: EN := input, ENO => target */
+    Node *opx;        /* operator functions (ADD, GT, ...): the operator expression they mean */
     bool is_const;    /* constant expression */
     int64_t cval;     /* its integer value when is_const */
 };
@@ -170,6 +174,7 @@ struct Pou {
     Type *type;           /* FB / program: its instance type */
     Vec syms;             /* Sym of its variables, in declaration order */
     Vec calls;            /* functions it calls (Pou*) */
+    Sym *en, *eno;        /* its EN input and ENO output, once a call or a body uses them */
 };
 
 typedef struct TypeDecl { char *name, *uname; Loc loc; TypeSpec *spec; Node *init; } TypeDecl;
@@ -257,6 +262,7 @@ struct Sym {
     bool in_function;     /* variable of a FUNCTION: C local or parameter */
     bool is_result;       /* the function's return variable */
     bool loop_locked;     /* FOR control variable inside its loop */
+    bool implicit;        /* EN / ENO nobody declared: never a positional argument */
 };
 
 extern Type *ty_prim[T__COUNT];
@@ -286,6 +292,9 @@ enum {
     B_NONE, B_CONV, B_TRUNC, B_ABS, B_SQRT, B_LN, B_LOG, B_EXP, B_SIN, B_COS, B_TAN,
     B_ASIN, B_ACOS, B_ATAN, B_EXPT, B_SEL, B_MAX, B_MIN, B_LIMIT, B_MUX, B_MOVE,
     B_SHL, B_SHR, B_ROL, B_ROR, B_LEN,
+    B_OP,       /* ADD, SUB, ..., GT, ..., NOT: Node.opx holds the operator expression */
+    B_DIV,      /* DIV: like '/', and ENO is FALSE on a zero divisor */
+    B_CONCAT,
 };
 
 #endif

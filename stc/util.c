@@ -108,15 +108,14 @@ static const char *line_of(Loc loc, int *len) {
     return t;
 }
 
-static void verror(Loc loc, const char *f, va_list ap) {
-    error_count++;
+static void vdiag(Loc loc, const char *kind, const char *f, va_list ap) {
     if (!loc.src) {
-        fputs("stc: error: ", stderr);
+        fprintf(stderr, "stc: %s: ", kind);
         vfprintf(stderr, f, ap);
         fputc('\n', stderr);
         return;
     }
-    fprintf(stderr, "%s:%d:%d: error: ", loc.src->name, loc.line, loc.col);
+    fprintf(stderr, "%s:%d:%d: %s: ", loc.src->name, loc.line, loc.col, kind);
     vfprintf(stderr, f, ap);
     fputc('\n', stderr);
     int len;
@@ -138,11 +137,23 @@ static void verror(Loc loc, const char *f, va_list ap) {
     fputs("\n  ", stderr);
     for (int i = 0; i < col && i < len; i++) fputc(s[i] == '\t' ? '\t' : ' ', stderr);
     fputs("^\n", stderr);
+}
+
+static void verror(Loc loc, const char *f, va_list ap) {
+    error_count++;
+    vdiag(loc, "error", f, ap);
     if (error_count >= MAX_ERRORS) {
         fprintf(stderr, "stc: too many errors, stopping\n");
         if (stc_error_jmp) longjmp(*stc_error_jmp, 1);
         exit(1);
     }
+}
+
+void warning_at(Loc loc, const char *f, ...) {
+    va_list ap;
+    va_start(ap, f);
+    vdiag(loc, "warning", f, ap);
+    va_end(ap);
 }
 
 void error_at(Loc loc, const char *f, ...) {

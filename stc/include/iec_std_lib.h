@@ -67,6 +67,14 @@ static inline IEC_TIME __dt_to_date(IEC_TIME t) {
 }
 
 /* ---- strings ---- */
+/* CONCAT: what does not fit in STR_MAX_LEN characters is cut off. */
+static inline STRING __str_concat(STRING a, STRING b) {
+    int n = b.len;
+    if (a.len + n > STR_MAX_LEN) n = STR_MAX_LEN - a.len;
+    memcpy(a.body + a.len, b.body, (size_t)n);
+    a.len = (uint8_t)(a.len + n);
+    return a;
+}
 static inline int __str_cmp(STRING a, STRING b) {
     int n = a.len < b.len ? a.len : b.len;
     int c = memcmp(a.body, b.body, (size_t)n);
@@ -90,6 +98,17 @@ __IEC_UNSIGNED(USINT)
 __IEC_UNSIGNED(UINT)
 __IEC_UNSIGNED(UDINT)
 __IEC_UNSIGNED(ULINT)
+
+/* DIV as a function (matiec's DIV_*): a zero divisor gives 0 and ENO = FALSE. */
+#define __IEC_DIVF(T, Q)                                                           \
+    static inline T __DIVF_##T(T a, T b, BOOL *eno) {                              \
+        if (eno) *eno = b != 0;                                                    \
+        return b == 0 ? (T)0 : (T)(Q);                                             \
+    }
+__IEC_DIVF(SINT, __DIV_SINT(a, b)) __IEC_DIVF(INT, __DIV_INT(a, b))
+__IEC_DIVF(DINT, __DIV_DINT(a, b)) __IEC_DIVF(LINT, __DIV_LINT(a, b))
+__IEC_DIVF(USINT, a / b) __IEC_DIVF(UINT, a / b) __IEC_DIVF(UDINT, a / b) __IEC_DIVF(ULINT, a / b)
+__IEC_DIVF(REAL, a / b) __IEC_DIVF(LREAL, a / b)
 
 /* REAL to integer: to nearest, ties to even (as matiec), saturated; NaN gives 0. */
 #define __IEC_FROM_REAL(T, LO, HI)                                                 \

@@ -7,6 +7,8 @@
 # A file whose first line is (* MUST-FAIL ... *) only has to be rejected
 # with a file:line:col diagnostic, (* MAY-PASS ... *) may also be accepted;
 # neither may crash stc or take more than 5 s.
+# A file whose first line is (* EXPECT-WARNING line:col message text *) must
+# compile (status 0) with exactly one "warning:" line, at line:col, with the text.
 # Then more such inputs, generated into OUTDIR.
 #   tests/stc/errors.sh OUTDIR file.st...
 # Environment: STC (compiler command). Prints PASS:/FAIL: lines.
@@ -40,8 +42,21 @@ check_robust() {
         fail "robust $name: no $file:line:col: error: line" "$(printf '%s\n' "$log" | head -c 300)"
     fi
 }
+check_warning() {
+    local f=$1 L=$2 C=$3 msg=$4
+    local name="$f: warning $L:$C $msg"
+    compile "$f"
+    if [ $rc -ne 0 ]; then fail "$name: exit status $rc, expected 0" "$(printf '%s\n' "$log" | head -5)"; return; fi
+    local w; w=$(printf '%s\n' "$log" | grep ': warning: ')
+    if [ "$(printf '%s\n' "$w" | grep -c .)" -ne 1 ]; then fail "$name: expected one warning" "$w"; return; fi
+    if [[ $w != "$f:$L:$C: warning: "*"$msg"* ]]; then fail "$name: wrong warning" "$w"; return; fi
+    pass "$name"
+}
 for f in "$@"; do
     head=$(head -n 1 "$f")
+    if [[ $head =~ ^\(\*\ EXPECT-WARNING\ ([0-9]+):([0-9]+)\ (.*[^ ])\ *\*\)$ ]]; then
+        check_warning "$f" "${BASH_REMATCH[1]}" "${BASH_REMATCH[2]}" "${BASH_REMATCH[3]}"; continue
+    fi
     case $head in
     "(* MUST-FAIL "*) check_robust must_fail "$f" "$f"; continue ;;
     "(* MAY-PASS "*) check_robust may_pass "$f" "$f"; continue ;;
