@@ -103,7 +103,7 @@ for s, di, ai, do, ao in ((s2, 0xA0, -1000, 0xAF, -500), (s3, 0x55, 32767, 0x5A,
     report(f"roundtrip_node{s.id}", ok, f"{rts[-1] * 1000:.0f} ms; "
            f"out 0x{s.get(0x6200, 1):02X} {s.get(0x6411, 1)}")
 rt = max(rts)
-patience = max(1.0, 10 * rt)   # for waits that check a value, not a time
+patience = max(5.0, 10 * rt)   # for waits that check a value, not a time
 report("modbus_sees_inputs", ireg(0, 2) == [(-1000) & 0xFFFF, 32767], str(ireg(0, 2)))
 
 # node 3's heartbeat stops: outputs safe, fault flagged within two consumer
