@@ -114,6 +114,11 @@ static int config(void *st, const char *sec, const char *key, const char *v, cha
             return -1;
         }
         *(double *)((char *)&a->p + pk[i].off) = x;
+        if (plant_has_modes(&a->p) && a->p.resonance > 0) {
+            snprintf(err, n, "resonance and mode1_hz/mode2_hz exclude each other "
+                     "(the elastic modes replace the legacy resonance)");
+            return -1;
+        }
         return 0;
     }
     snprintf(err, n, "unknown key");
