@@ -12,6 +12,19 @@
 **        the count latched exactly there
 **     -> home cam: on while cam_low <= position <= cam_high.
 **
+** Elastic modes (mode_hz[0..1] > 0; then `resonance` is not used): the
+** load is coupled to the motor through up to two modes, each a natural
+** frequency and a damping ratio. The load is split into parallel partial
+** masses in the ratio of mode_share; mode i's deflection d_i = x_load_i - x_m
+** obeys d_i'' + 2 zeta_i w_i d_i' + w_i^2 d_i = -a_motor + f, f = force on
+** the load / load mass (counts/s^2: the input `force` plus the disturbance
+** generator). The load position is x_m + sum w_i d_i (w_i = normalised
+** shares), its acceleration what an accelerometer on the load shows. The
+** drive stays an ideal speed source: the motor ignores the load's reaction.
+** The linear part is integrated exactly (matrix exponential with the inputs
+** held over each sub-step), so frequencies and decays are the parameters'.
+** A motor encoder (plant_motor_counter) sits beside the load encoder.
+**
 ** Units: counts and seconds. Used by the `sim` I/O backend and, through
 ** the double-array form below, by the ST block SIM_AXIS (c_blocks/).
 */
@@ -32,6 +45,13 @@ typedef struct plant_params {
     double damping;       /* ratio */
     double cam_low, cam_high;   /* counts; cam_low > cam_high = no cam */
     double start;         /* counts, initial position */
+    /* elastic modes (0 Hz = absent); any present replaces `resonance` */
+    double mode_hz[2];    /* Hz, natural (undamped) frequency */
+    double mode_zeta[2];  /* damping ratio, 0 <= zeta < 1 */
+    double mode_share[2]; /* share of the load mass in the mode (normalised) */
+    /* disturbance on the load, counts/s^2 (force / load mass), from dist_start s:
+    ** dist_amp constant (dist_hz 0) or dist_amp sin(2 pi dist_hz (t - dist_start)) */
+    double dist_amp, dist_hz, dist_start;
 } plant_params;
 
 typedef struct plant {
@@ -42,13 +62,22 @@ typedef struct plant {
     int32_t latch;        /* count at the last zero pulse */
     uint32_t zeros;       /* zero pulses so far */
     int zero;             /* a zero pulse during the last step */
+    /* elastic modes */
+    double force;         /* counts/s^2: force on the load / load mass, set by the caller */
+    double d[2], dv[2];   /* modal deflections (counts) and their speeds */
+    double al;            /* load acceleration at the end of the last step */
+    double c_h;           /* sub-step of the cached discretisation (0 = none) */
+    double c_phi[6][8];   /* [state | input] -> next state over c_h */
 } plant;
 
 void plant_defaults(plant_params *p);
 void plant_init(plant *s, const plant_params *p);
 /* Advance by dt seconds with the DAC at dac. */
 void plant_step(plant *s, int16_t dac, double dt);
-int32_t plant_counter(const plant *s);
+int32_t plant_counter(const plant *s);           /* load encoder */
+int32_t plant_motor_counter(const plant *s);     /* motor encoder */
+/* Whether the elastic modes (not the legacy `resonance`) are in use. */
+int plant_has_modes(const plant_params *p);
 int plant_cam(const plant *s);
 
 /* The same model on a flat array, for C bodies of ST blocks (no structs
@@ -58,6 +87,10 @@ enum {
     PA_RES, PA_DAMP, PA_CAMLO, PA_CAMHI, PA_START,        /* parameters */
     PA_T, PA_VM, PA_XM, PA_VL, PA_XL, PA_LATCH, PA_ZEROS, /* state */
     PA_COUNTER, PA_ZERO, PA_CAM,                          /* outputs */
+    PA_M1HZ, PA_M1ZETA, PA_M1SHARE, PA_M2HZ, PA_M2ZETA, PA_M2SHARE,
+    PA_FORCE,                                             /* modes, input */
+    PA_D1, PA_D1V, PA_D2, PA_D2V,                         /* modal state */
+    PA_MCOUNTER, PA_ACC,                                  /* motor counter, load acc. */
     PA_N
 };
 /* v[PA_T] < 0 means "not started": the state is initialised first. */

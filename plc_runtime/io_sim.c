@@ -3,7 +3,9 @@
 ** each bound to located variables by [sim.axisN] sections. Without any
 ** such section one axis runs with the default bindings (docs/config.md).
 */
+#include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,10 +14,11 @@
 
 #define SIM_AXES 8
 
-enum { B_DAC, B_COUNTER, B_LATCH, B_ZERO, B_CAM, B_ZCOUNT, NBIND };
-static const char *bind_keys[NBIND] = { "dac", "counter", "latch", "zero", "cam", "zero_count" };
-static const char bind_size[NBIND] = { 'W', 'D', 'D', 'X', 'X', 'W' };
-static const char *bind_default[NBIND] = { "%QW0", "%ID0", "%ID1", "%IX0.0", "%IX0.1", "" };
+enum { B_DAC, B_COUNTER, B_LATCH, B_ZERO, B_CAM, B_ZCOUNT, B_MCOUNTER, B_LACC, NBIND };
+static const char *bind_keys[NBIND] = { "dac", "counter", "latch", "zero", "cam", "zero_count",
+                                        "motor_counter", "load_acc" };
+static const char bind_size[NBIND] = { 'W', 'D', 'D', 'X', 'X', 'W', 'D', 'D' };
+static const char *bind_default[NBIND] = { "%QW0", "%ID0", "%ID1", "%IX0.0", "%IX0.1", "", "", "" };
 
 typedef struct sim_axis {
     int used;
@@ -95,6 +98,12 @@ static int config(void *st, const char *sec, const char *key, const char *v, cha
         P("cam_low", cam_low, -2147483648.0, 2147483647.0),
         P("cam_high", cam_high, -2147483648.0, 2147483647.0),
         P("start", start, -2147483648.0, 2147483647.0),
+        P("mode1_hz", mode_hz[0], 0, 10000), P("mode1_zeta", mode_zeta[0], 0, 0.999),
+        P("mode1_share", mode_share[0], 1e-6, 1e6),
+        P("mode2_hz", mode_hz[1], 0, 10000), P("mode2_zeta", mode_zeta[1], 0, 0.999),
+        P("mode2_share", mode_share[1], 1e-6, 1e6),
+        P("dist_amp", dist_amp, -1e12, 1e12), P("dist_hz", dist_hz, 0, 10000),
+        P("dist_start", dist_start, 0, 1e9),
 #undef P
     };
     for (size_t i = 0; i < sizeof pk / sizeof pk[0]; i++) {
@@ -105,6 +114,11 @@ static int config(void *st, const char *sec, const char *key, const char *v, cha
             return -1;
         }
         *(double *)((char *)&a->p + pk[i].off) = x;
+        if (plant_has_modes(&a->p) && a->p.resonance > 0) {
+            snprintf(err, n, "resonance and mode1_hz/mode2_hz exclude each other "
+                     "(the elastic modes replace the legacy resonance)");
+            return -1;
+        }
         return 0;
     }
     snprintf(err, n, "unknown key");
@@ -122,10 +136,24 @@ static int open_(void *st, plc_image *img, uint64_t tick, char *err, size_t n)
             snprintf(err, n, "[sim.axis%d]: dac and counter must be set", i);
             return -1;
         }
+        if (plant_has_modes(&a->p) && a->p.resonance > 0) {
+            snprintf(err, n, "[sim.axis%d]: resonance and mode1_hz/mode2_hz exclude each other "
+                     "(the elastic modes replace the legacy resonance)", i);
+            return -1;
+        }
         plant_init(&a->s, &a->p);
     }
     s->started = 0;
     return 0;
+}
+
+/* counts/s^2 rounded, saturated to DINT */
+static int32_t acc_dint(double a)
+{
+    if (a != a) return 0;
+    if (a >= 2147483647.0) return INT32_MAX;
+    if (a <= -2147483648.0) return INT32_MIN;
+    return (int32_t)lround(a);
 }
 
 static int rd(void *st, plc_image *img, uint64_t now)
@@ -143,6 +171,8 @@ static int rd(void *st, plc_image *img, uint64_t now)
         if (a->bound[B_ZERO]) *plc_loc_ptr(img, &a->loc[B_ZERO]) = (uint8_t)a->s.zero;
         if (a->bound[B_CAM]) *plc_loc_ptr(img, &a->loc[B_CAM]) = (uint8_t)plant_cam(&a->s);
         if (a->bound[B_ZCOUNT]) img_set16(plc_loc_ptr(img, &a->loc[B_ZCOUNT]), 0, (int16_t)(uint16_t)a->s.zeros);
+        if (a->bound[B_MCOUNTER]) img_set32(plc_loc_ptr(img, &a->loc[B_MCOUNTER]), 0, plant_motor_counter(&a->s));
+        if (a->bound[B_LACC]) img_set32(plc_loc_ptr(img, &a->loc[B_LACC]), 0, acc_dint(a->s.al));
     }
     return 0;
 }

@@ -28,3 +28,6 @@ include tests/examples/tests.mk
 
 # ---- apossctl: the APOSS controller part ----
 include tests/apossctl/apossctl.mk
+
+# ---- isg: the ISG damping part (seed 004) ----
+include tests/isg/isg.mk

@@ -11,7 +11,9 @@
 #include <string.h>
 #include <sys/socket.h>
 #include <unistd.h>
+#include <math.h>
 #include "config.h"
+#include "io_backend.h"
 #include "../common/check_run.h"
 
 static plc_config c;
@@ -84,6 +86,62 @@ START_TEST(sim_good)
                     "[sim.axis3]\ndac = %MW1\ncounter = %MD2\n";
     ck_assert_msg(load(t) == 0, "%s", err);
     config_free(&c);
+}
+END_TEST
+
+/* The elastic modes, the disturbance and the new bindings of the sim
+** backend (docs/config.md) */
+START_TEST(sim_modes)
+{
+    const char *t = "[sim.axis0]\ndac = %QW0\ncounter = %ID0\nmotor_counter = %ID4\nload_acc = %MD7\n"
+                    "mode1_hz = 53\nmode1_zeta = 0.05\nmode1_share = 3\nmode2_hz = 11\nmode2_zeta = 0.2\n"
+                    "mode2_share = 1\ndist_amp = -2e5\ndist_hz = 0\ndist_start = 0.5\n";
+    ck_assert_msg(load(t) == 0, "%s", err);
+    config_free(&c);
+    bad("[sim.axis0]\nmode1_zeta = 1\n", "plant.ini:2: [sim.axis0] mode1_zeta: '1' is not a number in 0..0.999");
+    bad("[sim.axis0]\nmode2_hz = -3\n", "[sim.axis0] mode2_hz: '-3' is not a number");
+    bad("[sim.axis0]\nmode1_share = 0\n", "[sim.axis0] mode1_share: '0' is not a number");
+    bad("[sim.axis0]\nload_acc = %QD1\n", "load_acc must be an input");
+    bad("[sim.axis0]\nmotor_counter = %IW1\n", "must be a %..D address");
+    bad("[sim.axis0]\nresonance = 20\nmode2_hz = 53\n",
+        "plant.ini:3: [sim.axis0] mode2_hz: resonance and mode1_hz/mode2_hz exclude each other");
+    bad("[sim.axis0]\nmode1_hz = 53\nresonance = 20\n", "plant.ini:3: [sim.axis0] resonance: resonance and mode1_hz");
+}
+END_TEST
+
+static void sim_set(const io_backend_ops *o, void *st, const char *k, const char *v)
+{
+    char e[200];
+    ck_assert_msg(o->config(st, "sim.axis0", k, v, e, sizeof e) == 0, "%s = %s: %s", k, v, e);
+}
+
+/* The backend runs the modes: a force step on the load (motor still) shows
+** as d'' = F e^(-s t)(cos wd t - s/wd sin wd t) on load_acc. */
+START_TEST(sim_modes_run)
+{
+    const io_backend_ops *o = io_backend_find("sim");
+    static plc_image img;
+    char e[300];
+    void *st = o->create();
+    sim_set(o, st, "dac", "%QW0"); sim_set(o, st, "counter", "%ID0");
+    sim_set(o, st, "dac", "%QW0"); sim_set(o, st, "counter", "%ID0");
+    sim_set(o, st, "motor_counter", "%ID4"); sim_set(o, st, "load_acc", "%ID5");
+    sim_set(o, st, "mode1_hz", "53"); sim_set(o, st, "mode1_zeta", "0.05");
+    sim_set(o, st, "dist_amp", "200000"); sim_set(o, st, "dist_start", "0");
+    ck_assert_msg(o->open(st, &img, 1000000, e, sizeof e) == 0, "%s", e);
+    double w = 2 * M_PI * 53, sg = 0.05 * w, wd = w * sqrt(1 - 0.05 * 0.05);
+    for (int i = 0; i <= 100; i++) {
+        ck_assert_int_eq(o->read_inputs(st, &img, (uint64_t)i * 1000000), 0);
+        o->write_outputs(st, &img);
+        double t = i * 1e-3, a = 2e5 * exp(-sg * t) * (cos(wd * t) - sg / wd * sin(wd * t));
+        if (i == 0) a = 0;    /* the first cycle is the start: no time has passed */
+        ck_assert_msg(abs(img_get32(img.id, 5) - (int32_t)lround(a)) <= 1, "load_acc %d at %g s, expected %.0f",
+                      img_get32(img.id, 5), t, a);
+        ck_assert_int_eq(img_get32(img.id, 4), 0);
+    }
+    ck_assert_int_eq(img_get32(img.id, 0), (int32_t)floor(2e5 / (w * w) * (1 - exp(-sg * 0.1) *
+                     (cos(wd * 0.1) + sg / wd * sin(wd * 0.1)))));
+    o->close(st);
 }
 END_TEST
 
@@ -429,6 +487,8 @@ int main(void)
     tcase_add_test(t, defaults);
     tcase_add_test(t, good_file);
     tcase_add_test(t, sim_good);
+    tcase_add_test(t, sim_modes);
+    tcase_add_test(t, sim_modes_run);
     tcase_add_test(t, syntax);
     tcase_add_test(t, unknown);
     tcase_add_test(t, values);

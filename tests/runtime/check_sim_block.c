@@ -46,11 +46,51 @@ START_TEST(block_matches_backend)
 }
 END_TEST
 
+/* the elastic modes through the block's inputs and outputs, against the
+** backend configured alike (the force as a constant disturbance from 0 s) */
+START_TEST(modes_block_matches_backend)
+{
+    char err[200];
+    plc_program_linked.init();
+    void *st = io_sim.create();
+    static const char *kv[][2] = {
+        { "dac", "%QW0" }, { "counter", "%ID10" }, { "motor_counter", "%ID11" }, { "load_acc", "%ID12" },
+        { "mode1_hz", "53" }, { "mode1_zeta", "0.05" }, { "mode2_hz", "11" }, { "mode2_zeta", "0.3" },
+        { "mode2_share", "3" }, { "dist_amp", "100000" }, { "dist_start", "0" },
+    };
+    for (size_t i = 0; i < sizeof kv / sizeof kv[0]; i++)
+        ck_assert_msg(io_sim.config(st, "sim.axis0", kv[i][0], kv[i][1], err, sizeof err) == 0, "%s", err);
+    ck_assert_int_eq(io_sim.open(st, &plc_img, 1000000, err, sizeof err), 0);
+    int32_t *counter = var("CONFIG0.RES0.INST0.AX2.COUNTER"), *mcounter = var("CONFIG0.RES0.INST0.AX2.MCOUNTER");
+    double *acc = var("CONFIG0.RES0.INST0.AX2.ACC"), *pos = var("CONFIG0.RES0.INST0.AX2.POS");
+    double *mpos = var("CONFIG0.RES0.INST0.AX2.MPOS");
+    img_set16(plc_img.qw, 0, 16384);
+    io_sim.read_inputs(st, &plc_img, 0);
+    int differ = 0;
+    for (unsigned long k = 0; k < 1000; k++) {
+        plc_program_linked.run(k);
+        io_sim.write_outputs(st, &plc_img);
+        io_sim.read_inputs(st, &plc_img, (k + 1) * 1000000);
+        ck_assert_int_eq(*counter, img_get32(plc_img.id, 10));
+        ck_assert_int_eq(*mcounter, img_get32(plc_img.id, 11));
+        ck_assert_int_eq(lround(*acc), img_get32(plc_img.id, 12));
+        if (*counter != *mcounter) differ++;
+    }
+    /* the load lags the motor by the modes' static deflection under the force
+    ** F/w^2 shares: 1e5 (0.25/(2 pi 53)^2 + 0.75/(2 pi 11)^2) = 15.9 counts ahead */
+    double dstat = 1e5 * (0.25 / pow(2 * M_PI * 53, 2) + 0.75 / pow(2 * M_PI * 11, 2));
+    ck_assert_msg(fabs(*pos - *mpos - dstat) < 0.05, "load - motor %g, expected %g", *pos - *mpos, dstat);
+    ck_assert_int_gt(differ, 900);
+    io_sim.close(st);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("sim_block");
     TCase *t = tcase_create("st");
     tcase_add_test(t, block_matches_backend);
+    tcase_add_test(t, modes_block_matches_backend);
     suite_add_tcase(s, t);
     return check_run(s);
 }

@@ -19,7 +19,8 @@ $(eval $(call rt_unit,check_mbmap,$(RT_SRC_MAP)))
 $(eval $(call rt_unit,check_config,$(RT_SRC_CFG)))
 $(eval $(call rt_unit,check_retain,$(RT_SRC_RET)))
 $(eval $(call rt_unit,check_plant,c_blocks/plant.c))
-RT_UNITS := check_mbmap check_config check_retain check_plant
+$(eval $(call rt_unit,check_plant_modes,c_blocks/plant.c))
+RT_UNITS := check_mbmap check_config check_retain check_plant check_plant_modes
 RT_UNIT_BINS := $(foreach u,$(RT_UNITS),$(RT_T)/$(u) $(RT_T)/$(u)-san)
 
 .PHONY: test-runtime-units
