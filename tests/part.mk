@@ -28,3 +28,6 @@ include tests/examples/tests.mk
 
 # ---- apossctl: the APOSS controller part ----
 include tests/apossctl/apossctl.mk
+
+# ---- plcopen: the MC_* blocks over an EPICPOS axis ----
+include tests/plcopen/plcopen.mk
