@@ -31,3 +31,5 @@ include tests/apossctl/apossctl.mk
 
 # ---- isg: the ISG damping part (seed 004) ----
 include tests/isg/isg.mk
+# ---- plcopen: the MC_* blocks over an EPICPOS axis ----
+include tests/plcopen/plcopen.mk

@@ -1,0 +1,11 @@
+# PLCopen tests: ST programs driving the MC_* blocks over an EPICPOS axis on
+# the simulated plant (c_blocks/sim_axis.st), compiled with $(STC) and run by
+# the EPICPOS harness (see run.sh).
+PLCOPEN_TESTS := $(wildcard tests/plcopen/t_*.st)
+
+TESTS += test-plcopen
+
+.PHONY: test-plcopen
+test-plcopen: $(ST_LIB) $(STC)
+	@mk/suite.sh $(RESULTS) plcopen env STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" \
+	    CFLAGS="$(CFLAGS)" tests/plcopen/run.sh $(BUILD)/tests/plcopen $(ST_LIB) $(PLCOPEN_TESTS)
