@@ -25,3 +25,6 @@ TESTS += test-stc-run test-stc-errors test-stc-contract
 
 # ---- examples: the example programs under plcrt, over Modbus ----
 include tests/examples/tests.mk
+
+# ---- LJPROF: limited-jerk profiles, closed-form cases and Ruckig ----
+include tests/ljprof/ljprof.mk
