@@ -5,7 +5,7 @@
  *   p0 v0 a0 target VEL ACC DEC ACCMAX JERKMIN JERKMIN2 JERKMIN3 JERKMIN4 PROFTIME
  *
  * Each move: SETPOS to (p0, v0, a0), POSA to target, then samples until done
- * (at most 10^7).  Prints one line per move:
+ * (at most 10^7, or the first argument).  Prints one line per move:
  *
  *   ptime samples final_pos vmax_ratio amax_ratio overshoot snaperr err iters jerk_ok
  *
@@ -27,8 +27,9 @@ static double *L(const char *n)
     return p;
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    long maxs = argc > 1 ? atol(argv[1]) : 10000000;
     int16_t *cmd = located("%IW0", NULL);
     double *tpos = L("%IL1"), *vset = L("%IL2"), *aset = L("%IL3"), *vl = L("%IL4"),
            *ac = L("%IL5"), *dc = L("%IL6"), *am = L("%IL7"), *jm[4] = {L("%IL8"), L("%IL9"),
@@ -60,7 +61,7 @@ int main(void)
         double vmax = 0, amax = 0, over = 0;
         int jok = 1;
         long s;
-        for (s = 1; s <= 10000000; s++) {
+        for (s = 1; s <= maxs; s++) {
             config_run__(tick++);
             *cmd = 0;
             if (s == 1) {
