@@ -19,7 +19,7 @@ $(LJPROF_B)/drive/drive: tests/ljprof/drive.c tests/ljprof/drive.st st/ljprof.st
 	@rm -rf $(@D) && mkdir -p $(@D)
 	cat st/ljprof.st tests/ljprof/drive.st > $(@D)/all.st
 	@bash -c '. tests/common/st_build.sh && STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" \
-	    CFLAGS="$(CFLAGS)" && st_compile $(@D)/all.st $(@D) ljprof-ruckig/build && \
+	    CFLAGS="$(CFLAGS) $(SAN)" && st_compile $(@D)/all.st $(@D) ljprof-ruckig/build && \
 	    st_link $(@D) tests/ljprof/drive.c $@ ljprof-ruckig/build'
 
 test-ljprof-ruckig: $(LJPROF_B)/drive/drive
