@@ -28,3 +28,17 @@ bench-epicpos: $(STC) $(ST_LIB) $(C_BLOCKS_OBJ) $(PLCRT_MAIN) $(PLCRT_OBJ)
 	  GEN_CFLAGS="$(PLC_GEN_CFLAGS)" CFLAGS="$(CFLAGS)" PLCRT_LINK="$(abspath $(PLCRT_MAIN) $(PLCRT_OBJ))" \
 	  PLCRT_LIBS="$(PLCRT_LIBS)" python3 bench/epicpos/bench.py $(BENCH_B)/epicpos
 BENCHES += bench-epicpos
+
+# LJPROF: p50/p99 cost of a re-plan call in stc's generated C, and planned
+# durations against Ruckig on thousands of random moves (bench/ljprof/)
+$(BENCH_B)/ljprof/replan: bench/ljprof/replan.c tests/ljprof/drive.st st/ljprof.st $(STC) tests/common/st_build.sh
+	@rm -rf $(@D) && mkdir -p $(@D)
+	cat st/ljprof.st tests/ljprof/drive.st > $(@D)/all.st
+	@bash -c '. tests/common/st_build.sh && STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" \
+	    CFLAGS="$(CFLAGS)" && st_compile $(@D)/all.st $(@D) bench-ljprof && \
+	    st_link $(@D) bench/ljprof/replan.c $@ bench-ljprof'
+
+.PHONY: bench-ljprof
+bench-ljprof: $(BENCH_B)/ljprof/replan $(BUILD)/tests/ljprof/drive/drive
+	python3 bench/ljprof/bench.py $(BENCH_B)/ljprof/replan $(BUILD)/tests/ljprof/drive/drive 3000
+BENCHES += bench-ljprof

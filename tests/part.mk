@@ -33,3 +33,5 @@ include tests/apossctl/apossctl.mk
 include tests/isg/isg.mk
 # ---- plcopen: the MC_* blocks over an EPICPOS axis ----
 include tests/plcopen/plcopen.mk
+# ---- LJPROF: limited-jerk profiles, closed-form cases and Ruckig ----
+include tests/ljprof/ljprof.mk
