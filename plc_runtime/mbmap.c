@@ -249,7 +249,14 @@ size_t mb_process(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
     atomic_fetch_add_explicit(&m->requests, 1, memory_order_relaxed);
     if (n < 1) return exc(m, rsp, 0, EX_FUNCTION);
     mb_flush(m);                       /* serve from the newest snapshot */
-    size_t r = serve(m, q, n, rsp);
+    size_t r;
+    int e = 0;
+    if (m->block.touches && (q[0] == 3 || q[0] == 6 || q[0] == 16 || q[0] == 23) && m->block.touches(q, n)) {
+        r = m->block.serve(m->block.arg, q, n, rsp, &e);
+        if (e) atomic_fetch_add_explicit(&m->exceptions, 1, memory_order_relaxed);
+    } else {
+        r = serve(m, q, n, rsp);
+    }
     mb_flush(m);                       /* and hand a write over at once */
     return r;
 }
@@ -307,7 +314,8 @@ int mb_flush(mb_shared *m)
 {
     take_snapshot(m);
     hand_over(m);
-    return m->fill->n > 0 || atomic_load_explicit(&m->ready, memory_order_relaxed);
+    int more = m->block.flush && m->block.flush(m->block.arg);
+    return more || m->fill->n > 0 || atomic_load_explicit(&m->ready, memory_order_relaxed);
 }
 
 void mb_apply(mb_shared *m, plc_image *img)
@@ -415,6 +423,8 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
         if (it->addr < fixed_end(it->table))
             FAIL("%s %u lies inside the fixed map (0..%u)", tabs[it->table], it->addr, fixed_end(it->table) - 1);
         if (it->addr + it->nregs > 65536) FAIL("does not fit below address 65536");
+        if (it->table == MB_HOLDING && it->addr < MB_TRACE_END && it->addr + it->nregs > MB_TRACE_BASE)
+            FAIL("holding registers %d..%d are the trace block (docs/trace.md)", MB_TRACE_BASE, MB_TRACE_END - 1);
         for (int j = 0; j < i; j++) {
             mb_item *o = &m->items[j];
             if (o->table == it->table && it->addr < o->addr + o->nregs && o->addr < it->addr + it->nregs)
