@@ -85,3 +85,11 @@ test-runtime-mbserver: $(BUILD)/plc/rt_iotest/plcrt $(BUILD)/plc/rt_fast/plcrt
 	@mk/suite.sh $(RESULTS) runtime-mbserver python3 tests/runtime/test_mbserver.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(BUILD)/plc/rt_fast/plcrt $(abspath $(RT_T))/mbserver
 TESTS += test-runtime-mbserver
+# the trace and forcing (docs/trace.md): plcrt on a program whose values
+# are functions of the cycle, the register block with pymodbus, plctrace
+$(eval $(call plcrt_program,rt_trace,tests/runtime/st/trace.st))
+.PHONY: test-runtime-trace
+test-runtime-trace: $(BUILD)/plc/rt_trace/plcrt
+	@mk/suite.sh $(RESULTS) runtime-trace python3 tests/runtime/test_trace.py \
+	  $(BUILD)/plc/rt_trace/plcrt $(abspath $(RT_T))/trace
+TESTS += test-runtime-trace
