@@ -28,3 +28,16 @@ bench-epicpos: $(STC) $(ST_LIB) $(C_BLOCKS_OBJ) $(PLCRT_MAIN) $(PLCRT_OBJ)
 	  GEN_CFLAGS="$(PLC_GEN_CFLAGS)" CFLAGS="$(CFLAGS)" PLCRT_LINK="$(abspath $(PLCRT_MAIN) $(PLCRT_OBJ))" \
 	  PLCRT_LIBS="$(PLCRT_LIBS)" python3 bench/epicpos/bench.py $(BENCH_B)/epicpos
 BENCHES += bench-epicpos
+
+# the trace: what 16 channels add to a scan (bench/runtime/tracecost.c) and
+# the download of 16 x 16384 samples over Modbus with plctrace's client
+$(eval $(call plcrt_program,bench_trace,bench/runtime/trace.st))
+$(BENCH_B)/runtime/tracecost: bench/runtime/tracecost.c plc_runtime/trace.c plc_runtime/trace.h
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -I plc_runtime -o $@ bench/runtime/tracecost.c plc_runtime/trace.c
+
+.PHONY: bench-trace
+bench-trace: $(BUILD)/plc/bench_trace/plcrt $(BENCH_B)/runtime/tracecost
+	python3 bench/runtime/trace_bench.py $(BUILD)/plc/bench_trace/plcrt $(BENCH_B)/runtime/tracecost \
+	  $(abspath $(BENCH_B))/trace
+BENCHES += bench-trace
