@@ -193,7 +193,7 @@ static void get_path(const uint16_t *r, unsigned n, char *s, size_t sn)
 }
 
 /* The variable named path: exactly (case-insensitive) or, failing that, the
-** one variable whose path ends with "." path. -1 if none or several. */
+** one variable whose path ends with "." path. -1 if none, -2 if several. */
 static long lookup(const plc_program *p, const char *path)
 {
     size_t n = strlen(path);
@@ -205,7 +205,7 @@ static long lookup(const plc_program *p, const char *path)
         const char *v = p->vars[i].path;
         size_t m = strlen(v);
         if (m > n && v[m - n - 1] == '.' && !strcasecmp(v + m - n, path)) {
-            if (hit >= 0) return -1;
+            if (hit >= 0) return -2;
             hit = (long)i;
         }
     }
@@ -286,7 +286,7 @@ static int command(tracemb *b, const uint16_t *r, unsigned n)
         char path[2 * TB_CMD_N + 1];
         get_path(a, n, path, sizeof path);
         long i = lookup(b->p, path);
-        if (i < 0) return EX_ADDRESS;
+        if (i < 0) return i == -1 ? EX_ADDRESS : EX_VALUE;
         b->res_index = (uint32_t)i;
         b->res_type = (uint16_t)trace_type(&b->p->vars[i]);
         b->res_size = b->p->vars[i].size;

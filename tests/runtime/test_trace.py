@@ -252,6 +252,8 @@ try:
         ("a read across the block's start", exc_of(c.read_holding_registers(BASE - 1, 3, slave=1)), 2),
         ("a read in the gap after the status", exc_of(c.read_holding_registers(BASE + 40, 2, slave=1)), 2),
         ("an unknown path", exc_of(c.write_registers(CMD, [0, LOOKUP] + text("no.such.var"), slave=1)), 2),
+        ("a tail several paths end with (axis.posit, axis2.posit)",
+         exc_of(c.write_registers(CMD, [0, LOOKUP] + text("posit"), slave=1)), 3),
         ("a window on channel 5 of a 1-channel capture",
          exc_of(c.readwrite_registers(read_address=WIN, read_count=2, write_address=SEL, values=[5, 0, 0], slave=1)), 2),
         ("a command of one register", exc_of(c.write_register(CMD, T, slave=1)), 3),
