@@ -125,6 +125,10 @@ void mb_free(mb_shared *m);
 /* Serve one request PDU (function code first); writes the reply PDU into
 ** rsp (MB_PDU_MAX bytes) and returns its length. Server thread. */
 size_t mb_process(mb_shared *m, const uint8_t *pdu, size_t n, uint8_t *rsp);
+/* A request PDU's shape (function code first): 1 when its length, counts
+** and byte count fit the function, 0 when not (exception 03), -1 for a
+** function this map does not serve (exception 01). */
+int mb_pdu_shape(const uint8_t *pdu, size_t n);
 /* Take the newest snapshot and hand the pending writes to the scan if it
 ** took the last batch in. Server thread; 1 while writes remain pending (call
 ** again within a period), else 0. mb_process calls it too. */

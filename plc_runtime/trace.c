@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include "plc_image.h"
 #include "trace.h"
 
 #define ACQ memory_order_acquire
@@ -35,17 +36,6 @@ double trace_number(uint64_t raw, int type)
     case TT_REAL: { uint32_t u = (uint32_t)raw; memcpy(&f, &u, 4); return f; }
     case TT_LREAL: memcpy(&d, &raw, 8); return d;
     default: return (double)raw;
-    }
-}
-
-static inline uint64_t load(const void *p, unsigned size)
-{
-    uint8_t b; uint16_t h; uint32_t w; uint64_t l;
-    switch (size) {
-    case 1: memcpy(&b, p, 1); return b;
-    case 2: memcpy(&h, p, 2); return h;
-    case 4: memcpy(&w, p, 4); return w;
-    default: memcpy(&l, p, 8); return l;
     }
 }
 
@@ -108,7 +98,7 @@ static int triggered(trace *t)
         atomic_store_explicit(&t->trig_req, 0, RLX);
         return 1;
     }
-    double x = trace_number(load(s->tv.addr, s->tv.size), s->tv.type), p = t->prev;
+    double x = trace_number(plc_load(s->tv.addr, s->tv.size), s->tv.type), p = t->prev;
     int have = t->n > 1;
     t->prev = x;
     if (!have) return 0;
@@ -152,7 +142,7 @@ void trace_cycle(trace *t, uint32_t cycle, uint32_t tick)
     if (t->dc++ % s->decim) return;
     trace_buf *b = t->cur;
     uint64_t *v = b->val + (size_t)t->w * (size_t)s->nchan;
-    for (int c = 0; c < s->nchan; c++) v[c] = load(s->ch[c].addr, s->ch[c].size);
+    for (int c = 0; c < s->nchan; c++) v[c] = plc_load(s->ch[c].addr, s->ch[c].size);
     b->cycle[t->w] = cycle;
     b->tick[t->w] = tick;
     if (t->n < s->samples) t->n++;
@@ -161,7 +151,7 @@ void trace_cycle(trace *t, uint32_t cycle, uint32_t tick)
         t->left = s->samples - s->pre;
         publish(t, TRACE_TRIGGERED);
     } else if (t->state == TRACE_ARMED && s->trig != TRIG_MANUAL && t->n <= s->pre) {
-        t->prev = trace_number(load(s->tv.addr, s->tv.size), s->tv.type);
+        t->prev = trace_number(plc_load(s->tv.addr, s->tv.size), s->tv.type);
     }
     if (++t->w == s->samples) t->w = 0;
     if (t->state == TRACE_TRIGGERED && --t->left == 0) complete(t);

@@ -385,30 +385,25 @@ size_t tb_serve(tracemb *b, const uint8_t *q, size_t n, uint8_t *rsp, int *e)
     *e = 0;
     rsp[0] = fc;
     memcpy(sel, b->sel, sizeof sel);
+    if (mb_pdu_shape(q, n) != 1) return exc(rsp, fc, EX_VALUE, e);
     switch (fc) {
     case 3:
-        if (n != 5 || cnt < 1 || cnt > 125) return exc(rsp, fc, EX_VALUE, e);
         if (!readable(a, cnt) || read_regs(b, a, cnt, sel, out)) return exc(rsp, fc, EX_ADDRESS, e);
         break;
     case 6:
-        if (n != 5) return exc(rsp, fc, EX_VALUE, e);
         r[0] = (uint16_t)cnt;
         if ((x = write_regs(b, a, 1, r, sel, 0))) return exc(rsp, fc, x, e);
         memcpy(b->sel, sel, sizeof sel);
         memcpy(rsp, q, 5);
         return 5;
     case 16:
-        if (n < 6 || cnt < 1 || cnt > 123 || q[5] != 2 * cnt || n != 6u + q[5]) return exc(rsp, fc, EX_VALUE, e);
         get_regs(q + 6, cnt, r);
         if ((x = write_regs(b, a, cnt, r, sel, 0))) return exc(rsp, fc, x, e);
         memcpy(b->sel, sel, sizeof sel);
         memcpy(rsp, q, 5);
         return 5;
     case 23: {
-        if (n < 10) return exc(rsp, fc, EX_VALUE, e);
         unsigned wa = u16(q + 5), wn = u16(q + 7);
-        if (cnt < 1 || cnt > 125 || wn < 1 || wn > 121 || q[9] != 2 * wn || n != 10u + q[9])
-            return exc(rsp, fc, EX_VALUE, e);
         get_regs(q + 10, wn, r);
         /* checked whole first: the write's place and the read with it */
         if ((x = write_regs(b, wa, wn, r, sel, 1))) return exc(rsp, fc, x, e);
