@@ -9,7 +9,7 @@
 
 _Static_assert(TB_END == MB_TRACE_END, "the block's end in mbmap.h");
 
-#define OWNER_STALE_NS (30 * 1000000000ull)   /* a silent owner of an idle trace */
+#define OWNER_STALE_NS (30 * 1000000000ull)   /* an owner silent this long gives way */
 
 enum { EX_FUNCTION = 1, EX_ADDRESS = 2, EX_VALUE = 3, EX_BUSY = 6 };
 
@@ -296,11 +296,10 @@ static int command(tracemb *b, const uint16_t *r, unsigned n)
     if (cmd < C_CLAIM || cmd > C_NEXT) return EX_FUNCTION;
 
     trace *t = b->t;
-    int running = trace_running(t);
     uint64_t now = scan_now_ns();
     if (cmd == C_CLAIM) {
         if (!token || n) return EX_VALUE;
-        if (b->owned && b->owner != token && (running || now - b->owner_ns < OWNER_STALE_NS)) return EX_BUSY;
+        if (b->owned && b->owner != token && now - b->owner_ns < OWNER_STALE_NS) return EX_BUSY;
         b->owned = 1;
         b->owner = token;
         b->owner_ns = now;
@@ -308,6 +307,7 @@ static int command(tracemb *b, const uint16_t *r, unsigned n)
     }
     if (!b->owned || token != b->owner) return EX_BUSY;
     b->owner_ns = now;
+    int running = trace_running(t);
     switch (cmd) {
     case C_RELEASE:
         if (n) return EX_VALUE;
