@@ -139,7 +139,9 @@ void trace_cycle(trace *t, uint32_t cycle, uint32_t tick)
     if (t->state == TRACE_WAIT_BUFFER) start(t);
     if (t->state != TRACE_ARMED && t->state != TRACE_TRIGGERED) return;
     const trace_setup *s = &t->run;
-    if (t->dc++ % s->decim) return;
+    uint32_t d = t->dc;                    /* a sample when it is 0 */
+    t->dc = d + 1 == s->decim ? 0 : d + 1;
+    if (d) return;
     trace_buf *b = t->cur;
     uint64_t *v = b->val + (size_t)t->w * (size_t)s->nchan;
     for (int c = 0; c < s->nchan; c++) v[c] = plc_load(s->ch[c].addr, s->ch[c].size);
