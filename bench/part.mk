@@ -32,7 +32,7 @@ BENCHES += bench-epicpos
 # the trace: what 16 channels add to a scan (bench/runtime/tracecost.c) and
 # the download of 16 x 16384 samples over Modbus with plctrace's client
 $(eval $(call plcrt_program,bench_trace,bench/runtime/trace.st))
-$(BENCH_B)/runtime/tracecost: bench/runtime/tracecost.c plc_runtime/trace.c plc_runtime/trace.h
+$(BENCH_B)/runtime/tracecost: bench/runtime/tracecost.c plc_runtime/trace.c plc_runtime/trace.h plc_runtime/plc_image.h
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) -I plc_runtime -o $@ bench/runtime/tracecost.c plc_runtime/trace.c
 
