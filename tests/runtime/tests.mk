@@ -7,6 +7,7 @@ RT_SRC_MAP := $(addprefix plc_runtime/,mbmap.c config.c program.c plc_image.c lo
 RT_SRC_CFG := $(addprefix plc_runtime/,config.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
 RT_SRC_RET := plc_runtime/retain.c plc_runtime/log.c
 RT_SRC_TRACE := plc_runtime/trace.c plc_runtime/force.c plc_runtime/plc_image.c
+RT_SRC_TRACEMB := $(RT_SRC_TRACE) $(addprefix plc_runtime/,tracemb.c mbmap.c scan.c stats.c log.c program.c)
 
 define rt_unit
 $(RT_T)/$(1): tests/runtime/$(1).c $(2) $$(PLCRT_HDRS)
@@ -21,7 +22,8 @@ $(eval $(call rt_unit,check_config,$(RT_SRC_CFG)))
 $(eval $(call rt_unit,check_retain,$(RT_SRC_RET)))
 $(eval $(call rt_unit,check_plant,c_blocks/plant.c))
 $(eval $(call rt_unit,check_trace,$(RT_SRC_TRACE)))
-RT_UNITS := check_mbmap check_config check_retain check_plant check_trace
+$(eval $(call rt_unit,check_tracemb,$(RT_SRC_TRACEMB)))
+RT_UNITS := check_mbmap check_config check_retain check_plant check_trace check_tracemb
 RT_UNIT_BINS := $(foreach u,$(RT_UNITS),$(RT_T)/$(u) $(RT_T)/$(u)-san)
 
 .PHONY: test-runtime-units
