@@ -42,3 +42,16 @@ $(BENCH_B)/ljprof/replan: bench/ljprof/replan.c tests/ljprof/drive.st st/ljprof.
 bench-ljprof: $(BENCH_B)/ljprof/replan $(BUILD)/tests/ljprof/drive/drive
 	python3 bench/ljprof/bench.py $(BENCH_B)/ljprof/replan $(BUILD)/tests/ljprof/drive/drive 3000
 BENCHES += bench-ljprof
+
+# the trace: what 16 channels add to a scan (bench/runtime/tracecost.c) and
+# the download of 16 x 16384 samples over Modbus with plctrace's client
+$(eval $(call plcrt_program,bench_trace,bench/runtime/trace.st))
+$(BENCH_B)/runtime/tracecost: bench/runtime/tracecost.c plc_runtime/trace.c plc_runtime/trace.h plc_runtime/plc_image.h
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -I plc_runtime -o $@ bench/runtime/tracecost.c plc_runtime/trace.c
+
+.PHONY: bench-trace
+bench-trace: $(BUILD)/plc/bench_trace/plcrt $(BENCH_B)/runtime/tracecost
+	python3 bench/runtime/trace_bench.py $(BUILD)/plc/bench_trace/plcrt $(BENCH_B)/runtime/tracecost \
+	  $(abspath $(BENCH_B))/trace
+BENCHES += bench-trace

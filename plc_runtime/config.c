@@ -78,6 +78,8 @@ static const struct key {
     { "modbus", "idle_timeout", K_INT, 0, 86400, F(mb_idle_timeout) },
     { "retain", "file", K_STR, 0, 0, F(retain_file) },
     { "retain", "period", K_INT, 0, 86400, F(retain_period) },
+    { "trace", "samples", K_INT, 16384, 1048576, F(trace_samples) },
+    { "debug", "allow_force", K_BOOL, 0, 0, F(allow_force) },
 };
 _Static_assert(sizeof keys / sizeof keys[0] == CFG_NKEYS, "CFG_NKEYS counts keys[]");
 
@@ -529,6 +531,7 @@ int config_defaults(plc_config *c, char *err, size_t errlen)
     c->mb_idle_timeout = 10;
     strcpy(c->retain_file, "plcrt.retain");
     c->retain_period = 10;
+    c->trace_samples = 16384;
     c->io = io_backend_find(c->backend);
     if (!(c->io_state = c->io->create())) {
         snprintf(err, errlen, "out of memory");

@@ -21,7 +21,7 @@
 #define CFG_MAX_STATUS 8
 #define CFG_MAX_LINE 2048       /* characters in one line, newline excluded */
 #define CFG_MAX_FILE (1 << 20)  /* bytes in one file */
-#define CFG_NKEYS 15            /* keys of the runtime's own sections */
+#define CFG_NKEYS 17            /* keys of the runtime's own sections */
 
 enum { MB_COILS, MB_DISCRETE, MB_INPUT, MB_HOLDING };
 
@@ -61,6 +61,10 @@ typedef struct plc_config {
     /* [retain] */
     char retain_file[256];              /* "" = no retain */
     int retain_period;                  /* s, 0 = only at shutdown */
+    /* [trace] */
+    int trace_samples;                  /* per channel and buffer */
+    /* [debug] */
+    int allow_force;
     int key_line[CFG_NKEYS];            /* where each key was given, 0 = default */
 } plc_config;
 

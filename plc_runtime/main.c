@@ -16,12 +16,15 @@
 #include <time.h>
 #include <unistd.h>
 #include "config.h"
+#include "force.h"
 #include "log.h"
 #include "mbmap.h"
 #include "mbserver.h"
 #include "program.h"
 #include "retain.h"
 #include "scan.h"
+#include "trace.h"
+#include "tracemb.h"
 
 #define PLCRT_VERSION "0.1.0"
 
@@ -240,6 +243,21 @@ int main(int argc, char **argv)
     clock_gettime(CLOCK_REALTIME, &rt);
     sc.base_sec = rt.tv_sec; sc.base_nsec = rt.tv_nsec;
     stats_reset(&sc.stats);
+    /* trace and forcing: over Modbus only; buffers allocated (and touched) now */
+    trace *tr = NULL;
+    forcing *fo = NULL;
+    tracemb *tb = NULL;
+    if (mb) {
+        if (!(tr = trace_new((uint32_t)cfg.trace_samples)) || !(fo = force_new(prog, cfg.allow_force))
+            || !(tb = tb_new(tr, fo, prog, period))) {
+            fprintf(stderr, "plcrt: out of memory for the trace ([trace] samples = %d)\n", cfg.trace_samples);
+            return 1;
+        }
+        mb->block = tb_block(tb);
+        sc.trace = tr;
+        sc.force = fo;
+        if (cfg.allow_force) plc_log(LOG_WARN, "forcing allowed ([debug] allow_force)");
+    }
     if (mb) {
         uint16_t diag[MB_DIAG_N];
         scan_diag(&sc, diag);
@@ -323,13 +341,17 @@ int main(int argc, char **argv)
         if (cfg.status_interval && now - t_status >= (uint64_t)cfg.status_interval * 1000000000u) {
             t_status = now;
             char line[1024];
-            int k = snprintf(line, sizeof line, "cycles %" PRIu64 "  overruns %" PRIu64 "  worst latency %.1f us",
-                             (uint64_t)atomic_load(&sc.stats.cycles), ov, ls.max_ns / 1e3);
+            int nf = fo ? force_count(fo) : 0, k = 0;
+            if (nf) k = snprintf(line, sizeof line, "FORCED %d  ", nf);
+            k += snprintf(line + k, sizeof line - (size_t)k, "cycles %" PRIu64 "  overruns %" PRIu64 "  worst latency %.1f us",
+                          (uint64_t)atomic_load(&sc.stats.cycles), ov, ls.max_ns / 1e3);
             if (cfg.nstatus && !scan_sample_now(&sc, ss, (size_t)cfg.nstatus, 1, 500)) {
                 for (int i = 0; i < cfg.nstatus && k < (int)sizeof line - 80; i++) {
                     char val[64];
                     fmt_var(val, sizeof val, status[i], sbuf[i]);
-                    k += snprintf(line + k, sizeof line - (size_t)k, "  %s %s", short_path(status[i]->path), val);
+                    int forced = fo && force_is_forced(fo, (uint32_t)(status[i] - prog->vars));
+                    k += snprintf(line + k, sizeof line - (size_t)k, "  %s %s%s", short_path(status[i]->path), val,
+                                  forced ? " (forced)" : "");
                 }
             }
             printf("%s\n", line);
@@ -342,5 +364,8 @@ int main(int argc, char **argv)
     }
 
     shut_down(&sc, th, srv, mb, &cfg, &ret);
+    tb_free(tb);
+    force_free(fo);
+    trace_free(tr);
     return 0;
 }

@@ -66,17 +66,6 @@ static int resolve(mb_shared *m, int table, unsigned a, cell *c)
     return item_cell(m, table, a, c);
 }
 
-static uint64_t load(const uint8_t *p, unsigned size)
-{
-    uint8_t b; uint16_t h; uint32_t w; uint64_t l;
-    switch (size) {
-    case 1: memcpy(&b, p, 1); return b;
-    case 2: memcpy(&h, p, 2); return h;
-    case 4: memcpy(&w, p, 4); return w;
-    default: memcpy(&l, p, 8); return l;
-    }
-}
-
 static void store(uint8_t *p, unsigned size, uint64_t x)
 {
     uint8_t b = (uint8_t)x; uint16_t h = (uint16_t)x; uint32_t w = (uint32_t)x;
@@ -90,7 +79,7 @@ static void store(uint8_t *p, unsigned size, uint64_t x)
 
 static uint16_t cell_get(const cell *c)
 {
-    uint64_t x = load(c->p, c->size);
+    uint64_t x = plc_load(c->p, c->size);
     return (uint16_t)(x >> (16 * (c->nwords - 1 - c->w)));
 }
 
@@ -100,7 +89,7 @@ static void cell_set(mb_shared *m, const cell *c, uint16_t v)
     if (c->is_bool) store(c->p, c->size, v != 0);
     else {
         unsigned sh = 16 * (c->nwords - 1 - c->w);
-        uint64_t x = load(c->p, c->size);
+        uint64_t x = plc_load(c->p, c->size);
         x = (x & ~((uint64_t)0xffff << sh)) | ((uint64_t)v << sh);
         store(c->p, c->size, x);
     }
@@ -175,27 +164,45 @@ static void write_regs(mb_shared *m, unsigned a, unsigned n, const uint8_t *vals
     }
 }
 
+int mb_pdu_shape(const uint8_t *q, size_t n)
+{
+    unsigned cnt = n >= 5 ? u16(q + 3) : 0;
+    switch (q[0]) {
+    case 1: case 2: return n == 5 && cnt >= 1 && cnt <= 2000;
+    case 3: case 4: return n == 5 && cnt >= 1 && cnt <= 125;
+    case 5: return n == 5 && (cnt == 0xFF00 || cnt == 0);
+    case 6: return n == 5;
+    case 15: return n >= 6 && cnt >= 1 && cnt <= 1968 && q[5] == (cnt + 7) / 8 && n == 6u + q[5];
+    case 16: return n >= 6 && cnt >= 1 && cnt <= 123 && q[5] == 2 * cnt && n == 6u + q[5];
+    case 23: {
+        if (n < 10) return 0;
+        unsigned wn = u16(q + 7);
+        return cnt >= 1 && cnt <= 125 && wn >= 1 && wn <= 121 && q[9] == 2 * wn && n == 10u + q[9];
+    }
+    }
+    return -1;
+}
+
 static size_t serve(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
 {
     uint8_t fc = q[0];
     unsigned a = n >= 3 ? u16(q + 1) : 0, cnt = n >= 5 ? u16(q + 3) : 0;
-    int e;
+    int e, shape = mb_pdu_shape(q, n);
     rsp[0] = fc;
+    if (shape < 0) return exc(m, rsp, fc, EX_FUNCTION);
+    if (!shape) return exc(m, rsp, fc, EX_VALUE);
     switch (fc) {
     case 1: case 2: {
         int t = fc == 1 ? MB_COILS : MB_DISCRETE;
-        if (n != 5 || cnt < 1 || cnt > 2000) return exc(m, rsp, fc, EX_VALUE);
         if ((e = check(m, t, a, cnt, 0))) return exc(m, rsp, fc, e);
         return read_bits(m, t, a, cnt, rsp);
     }
     case 3: case 4: {
         int t = fc == 3 ? MB_HOLDING : MB_INPUT;
-        if (n != 5 || cnt < 1 || cnt > 125) return exc(m, rsp, fc, EX_VALUE);
         if ((e = check(m, t, a, cnt, 0))) return exc(m, rsp, fc, e);
         return read_regs(m, t, a, cnt, rsp);
     }
     case 5: {
-        if (n != 5 || (cnt != 0xFF00 && cnt != 0)) return exc(m, rsp, fc, EX_VALUE);
         if ((e = check(m, MB_COILS, a, 1, 1))) return exc(m, rsp, fc, e);
         cell c;
         resolve(m, MB_COILS, a, &c);
@@ -204,15 +211,12 @@ static size_t serve(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
         return 5;
     }
     case 6: {
-        if (n != 5) return exc(m, rsp, fc, EX_VALUE);
         if ((e = check(m, MB_HOLDING, a, 1, 1))) return exc(m, rsp, fc, e);
         write_regs(m, a, 1, q + 3);
         memcpy(rsp, q, 5);
         return 5;
     }
     case 15: {
-        if (n < 6 || cnt < 1 || cnt > 1968 || q[5] != (cnt + 7) / 8 || n != 6u + q[5])
-            return exc(m, rsp, fc, EX_VALUE);
         if ((e = check(m, MB_COILS, a, cnt, 1))) return exc(m, rsp, fc, e);
         for (unsigned i = 0; i < cnt; i++) {
             cell c;
@@ -223,18 +227,13 @@ static size_t serve(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
         return 5;
     }
     case 16: {
-        if (n < 6 || cnt < 1 || cnt > 123 || q[5] != 2 * cnt || n != 6u + q[5])
-            return exc(m, rsp, fc, EX_VALUE);
         if ((e = check(m, MB_HOLDING, a, cnt, 1))) return exc(m, rsp, fc, e);
         write_regs(m, a, cnt, q + 6);
         memcpy(rsp, q, 5);
         return 5;
     }
     case 23: {
-        if (n < 10) return exc(m, rsp, fc, EX_VALUE);
         unsigned wa = u16(q + 5), wn = u16(q + 7);
-        if (cnt < 1 || cnt > 125 || wn < 1 || wn > 121 || q[9] != 2 * wn || n != 10u + q[9])
-            return exc(m, rsp, fc, EX_VALUE);
         if ((e = check(m, MB_HOLDING, wa, wn, 1)) || (e = check(m, MB_HOLDING, a, cnt, 0)))
             return exc(m, rsp, fc, e);
         write_regs(m, wa, wn, q + 10);        /* the write comes first */
@@ -249,7 +248,14 @@ size_t mb_process(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
     atomic_fetch_add_explicit(&m->requests, 1, memory_order_relaxed);
     if (n < 1) return exc(m, rsp, 0, EX_FUNCTION);
     mb_flush(m);                       /* serve from the newest snapshot */
-    size_t r = serve(m, q, n, rsp);
+    size_t r;
+    int e = 0;
+    if (m->block.touches && (q[0] == 3 || q[0] == 6 || q[0] == 16 || q[0] == 23) && m->block.touches(q, n)) {
+        r = m->block.serve(m->block.arg, q, n, rsp, &e);
+        if (e) atomic_fetch_add_explicit(&m->exceptions, 1, memory_order_relaxed);
+    } else {
+        r = serve(m, q, n, rsp);
+    }
     mb_flush(m);                       /* and hand a write over at once */
     return r;
 }
@@ -307,7 +313,8 @@ int mb_flush(mb_shared *m)
 {
     take_snapshot(m);
     hand_over(m);
-    return m->fill->n > 0 || atomic_load_explicit(&m->ready, memory_order_relaxed);
+    int more = m->block.flush && m->block.flush(m->block.arg);
+    return more || m->fill->n > 0 || atomic_load_explicit(&m->ready, memory_order_relaxed);
 }
 
 void mb_apply(mb_shared *m, plc_image *img)
@@ -415,6 +422,8 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
         if (it->addr < fixed_end(it->table))
             FAIL("%s %u lies inside the fixed map (0..%u)", tabs[it->table], it->addr, fixed_end(it->table) - 1);
         if (it->addr + it->nregs > 65536) FAIL("does not fit below address 65536");
+        if (it->table == MB_HOLDING && it->addr < MB_TRACE_END && it->addr + it->nregs > MB_TRACE_BASE)
+            FAIL("holding registers %d..%d are the trace block (docs/trace.md)", MB_TRACE_BASE, MB_TRACE_END - 1);
         for (int j = 0; j < i; j++) {
             mb_item *o = &m->items[j];
             if (o->table == it->table && it->addr < o->addr + o->nregs && o->addr < it->addr + it->nregs)

@@ -40,6 +40,8 @@
 #define MB_DIAG_N      128
 #define MB_LOG_MAX     16384   /* pending writes: more than the writable cells */
 #define MB_PDU_MAX     253
+#define MB_TRACE_BASE  60000   /* holding registers of the trace block (tracemb.h) */
+#define MB_TRACE_END   60429
 
 /* Diagnostics: input register offsets from MB_DIAG_BASE; 32-bit values,
 ** two registers, high word first. Times in microseconds. */
@@ -50,7 +52,7 @@ enum {
     MBD_TICK_US = 22, MBD_CLIENTS = 24, MBD_REFUSED = 26, MBD_REQUESTS = 28,
     MBD_EXCEPTIONS = 30, MBD_RETAIN_SAVES = 32, MBD_RETAIN_ERRORS = 34,
     MBD_IO_ERRORS = 36, MBD_UPTIME_S = 38, MBD_OVERRUNS_EXEC = 40,
-    MBD_EVICTED = 42, MBD_DROPPED = 44, MBD_EXCHANGE_MAX = 46,
+    MBD_EVICTED = 42, MBD_DROPPED = 44, MBD_EXCHANGE_MAX = 46, MBD_FORCED = 48,
     MBD_BACKEND = 64               /* 64 registers of the I/O backend */
 };
 
@@ -82,11 +84,21 @@ typedef struct mb_snap {           /* what clients read: one cycle's image */
     uint8_t (*items)[8];           /* symbol values */
 } mb_snap;
 
+/* Registers served by another module in the server thread (the trace
+** block, tracemb.h): requests that touch them are handed to serve whole. */
+typedef struct mb_block {
+    int (*touches)(const uint8_t *pdu, size_t n);
+    size_t (*serve)(void *arg, const uint8_t *pdu, size_t n, uint8_t *rsp, int *exc);
+    int (*flush)(void *arg);       /* 1 while it has work pending */
+    void *arg;
+} mb_block;
+
 #define MB_FRESH 4u                /* in mid: the middle snapshot is newer */
 
 typedef struct mb_shared {
     mb_item *items;
     size_t nitems;
+    mb_block block;                /* touches NULL: none */
     /* image out: the scan owns snap[back], the server snap[front] (its
     ** view, into which it also writes), mid holds the third */
     mb_snap snap[3];
@@ -113,6 +125,10 @@ void mb_free(mb_shared *m);
 /* Serve one request PDU (function code first); writes the reply PDU into
 ** rsp (MB_PDU_MAX bytes) and returns its length. Server thread. */
 size_t mb_process(mb_shared *m, const uint8_t *pdu, size_t n, uint8_t *rsp);
+/* A request PDU's shape (function code first): 1 when its length, counts
+** and byte count fit the function, 0 when not (exception 03), -1 for a
+** function this map does not serve (exception 01). */
+int mb_pdu_shape(const uint8_t *pdu, size_t n);
 /* Take the newest snapshot and hand the pending writes to the scan if it
 ** took the last batch in. Server thread; 1 while writes remain pending (call
 ** again within a period), else 0. mb_process calls it too. */

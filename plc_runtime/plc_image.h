@@ -44,6 +44,18 @@ static inline int64_t img_get64(const uint8_t *a, unsigned i)
 static inline void img_set64(uint8_t *a, unsigned i, int64_t v)
 { memcpy(a + 8 * i, &v, 8); }
 
+/* The value of 1, 2, 4 or 8 bytes at p (any alignment), zero-extended. */
+static inline uint64_t plc_load(const void *p, unsigned size)
+{
+    uint8_t b; uint16_t h; uint32_t w; uint64_t l;
+    switch (size) {
+    case 1: memcpy(&b, p, 1); return b;
+    case 2: memcpy(&h, p, 2); return h;
+    case 4: memcpy(&w, p, 4); return w;
+    default: memcpy(&l, p, 8); return l;
+    }
+}
+
 /* A located address parsed from text such as "%QW3" or "%IX0.1". */
 typedef struct plc_loc {
     char area;      /* 'I', 'Q', 'M' */

@@ -59,6 +59,7 @@ void scan_diag(scan *s, uint16_t *d)
     put32(d, MBD_RETAIN_SAVES, LD(s->retain_saves));
     put32(d, MBD_RETAIN_ERRORS, LD(s->retain_errors));
     put32(d, MBD_IO_ERRORS, LD(st->io_errors));
+    if (s->force) put32(d, MBD_FORCED, (uint64_t)force_count(s->force));
     put32(d, MBD_UPTIME_S, (scan_now_ns() - s->started_ns) / 1000000000u);
     if (s->io->diag) s->io->diag(s->io_state, d + MBD_BACKEND, MB_DIAG_N - MBD_BACKEND);
 }
@@ -110,10 +111,16 @@ __attribute__((noinline)) void scan_cycle(scan *s, uint64_t plc_ns, unsigned lon
         mb_apply(s->mb, &plc_img);
         x1 = scan_now_ns();
     }
+    if (s->force) {
+        force_begin(s->force);
+        force_apply(s->force, FORCE_AFTER_INPUTS);
+    }
     uint64_t ns = (uint64_t)s->base_nsec + plc_ns % 1000000000u;
     p->now->tv_sec = s->base_sec + (long)(plc_ns / 1000000000u) + (long)(ns / 1000000000u);
     p->now->tv_nsec = (long)(ns % 1000000000u);
     p->run(tick);
+    if (s->force) force_apply(s->force, FORCE_AFTER_PROGRAM);
+    if (s->trace) trace_cycle(s->trace, (uint32_t)LD(s->stats.cycles), (uint32_t)tick);
     take_samples(s);
     if (s->mb) {
         scan_diag(s, diag);

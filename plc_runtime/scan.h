@@ -1,7 +1,9 @@
 /*
 ** scan.h: the real-time scan thread. Each period (absolute
 ** clock_nanosleep on CLOCK_MONOTONIC): read inputs -> apply Modbus writes
-** -> run the program -> publish to Modbus -> write outputs. The Modbus
+** -> run the program -> publish to Modbus -> write outputs; forcing
+** (force.h) after the inputs and after the program, the trace (trace.h)
+** at the end of the cycle. The Modbus
 ** steps take and give whole buffers (mbmap.h): no lock, no waiting, no
 ** allocation; their longest cost is kept for the diagnostics. A cycle that
 ** ends past the next period boundary is an overrun: counted, and the next
@@ -12,10 +14,12 @@
 
 #include <stdatomic.h>
 #include <stddef.h>
+#include "force.h"
 #include "io_backend.h"
 #include "mbmap.h"
 #include "program.h"
 #include "stats.h"
+#include "trace.h"
 
 typedef struct scan_sample { void *src, *dst; size_t n; } scan_sample;
 
@@ -24,6 +28,8 @@ typedef struct scan {
     const io_backend_ops *io;
     void *io_state;
     mb_shared *mb;                 /* NULL: no Modbus */
+    trace *trace;                  /* NULL: no trace */
+    forcing *force;                /* NULL: no forcing */
     uint64_t period_ns;
     long base_sec, base_nsec;      /* __CURRENT_TIME at PLC time 0 */
     plc_stats stats;

@@ -44,6 +44,12 @@ START_TEST(defaults)
     ck_assert_str_eq(c.backend, "sim");
     ck_assert_int_eq(c.priority, 80);
     ck_assert_int_eq(c.retain_period, 10);
+    ck_assert_int_eq(c.trace_samples, 16384);   /* the issue: at least 16384 per channel */
+    ck_assert_int_eq(c.allow_force, 0);         /* forcing off unless enabled */
+    config_free(&c);
+    ck_assert_int_eq(load("[trace]\nsamples = 65536\n[debug]\nallow_force = yes\n"), 0);
+    ck_assert_int_eq(c.trace_samples, 65536);
+    ck_assert_int_eq(c.allow_force, 1);
     config_free(&c);
 }
 END_TEST
@@ -170,6 +176,8 @@ START_TEST(values)
     bad("[scan]\nlock_memory = maybe\n", "[scan] lock_memory: 'maybe' is not yes or no");
     bad("[plc]\nlog_level = loud\n", "[plc] log_level: 'loud'");
     bad("[retain]\nperiod = -1\n", "[retain] period");
+    bad("[trace]\nsamples = 1000\n", "plant.ini:2: [trace] samples: '1000' is not a decimal integer in 16384..1048576");
+    bad("[debug]\nallow_force = maybe\n", "plant.ini:2: [debug] allow_force: 'maybe' is not yes or no");
     bad("[modbus.symbols]\nA.B = register 100\n", "plant.ini:2: [modbus.symbols] A.B: table 'register'");
     bad("[modbus.symbols]\nA.B = holding\n", "expected TABLE ADDRESS [rw]");
     bad("[modbus.symbols]\nA.B = input 9000 rw\n", "read-only");

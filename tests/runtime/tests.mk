@@ -6,6 +6,8 @@ RT_CHECK_LIBS := $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -ls
 RT_SRC_MAP := $(addprefix plc_runtime/,mbmap.c config.c program.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
 RT_SRC_CFG := $(addprefix plc_runtime/,config.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
 RT_SRC_RET := plc_runtime/retain.c plc_runtime/log.c
+RT_SRC_TRACE := plc_runtime/trace.c plc_runtime/force.c plc_runtime/plc_image.c
+RT_SRC_TRACEMB := $(RT_SRC_TRACE) $(addprefix plc_runtime/,tracemb.c mbmap.c scan.c stats.c log.c program.c)
 
 define rt_unit
 $(RT_T)/$(1): tests/runtime/$(1).c $(2) $$(PLCRT_HDRS)
@@ -20,7 +22,9 @@ $(eval $(call rt_unit,check_config,$(RT_SRC_CFG)))
 $(eval $(call rt_unit,check_retain,$(RT_SRC_RET)))
 $(eval $(call rt_unit,check_plant,c_blocks/plant.c))
 $(eval $(call rt_unit,check_plant_modes,c_blocks/plant.c))
-RT_UNITS := check_mbmap check_config check_retain check_plant check_plant_modes
+$(eval $(call rt_unit,check_trace,$(RT_SRC_TRACE)))
+$(eval $(call rt_unit,check_tracemb,$(RT_SRC_TRACEMB)))
+RT_UNITS := check_mbmap check_config check_retain check_plant check_plant_modes check_trace check_tracemb
 RT_UNIT_BINS := $(foreach u,$(RT_UNITS),$(RT_T)/$(u) $(RT_T)/$(u)-san)
 
 .PHONY: test-runtime-units
@@ -102,3 +106,11 @@ $(eval $(call plcrt_program,rt_aggregates,tests/runtime/st/aggregates.st))
 test-runtime-aggregates: $(BUILD)/plc/rt_aggregates/plcrt
 	@mk/suite.sh $(RESULTS) runtime-aggregates python3 tests/runtime/test_aggregates.py $< $(abspath $(RT_T))/aggregates
 TESTS += test-runtime-aggregates
+# the trace and forcing (docs/trace.md): plcrt on a program whose values
+# are functions of the cycle, the register block with pymodbus, plctrace
+$(eval $(call plcrt_program,rt_trace,tests/runtime/st/trace.st))
+.PHONY: test-runtime-trace
+test-runtime-trace: $(BUILD)/plc/rt_trace/plcrt
+	@mk/suite.sh $(RESULTS) runtime-trace python3 tests/runtime/test_trace.py \
+	  $(BUILD)/plc/rt_trace/plcrt $(abspath $(RT_T))/trace
+TESTS += test-runtime-trace
