@@ -28,3 +28,6 @@ include tests/examples/tests.mk
 
 # ---- apossctl: the APOSS controller part ----
 include tests/apossctl/apossctl.mk
+
+# ---- the library in other environments: C++ linkage, PLCopen XML export ----
+include tests/xmlexport/xmlexport.mk
