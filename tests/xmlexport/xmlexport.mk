@@ -10,3 +10,10 @@ test-cxx-link: $(STC)
 	    CC="$(CC)" CFLAGS="$(CFLAGS)" CXX="$(CXX)" tests/xmlexport/cxx_link.sh $(CXX_LINK_OUT)
 
 TESTS += test-cxx-link
+
+.PHONY: test-xmlexport
+test-xmlexport: $(ST_LIB_XML) $(C_BLOCKS_XML) $(STC)
+	@mk/suite.sh $(RESULTS) xmlexport env STC="$(STC)" tests/xmlexport/run_xml.sh \
+	    $(BUILD)/tests/xmlexport $(ST_LIB_XML) $(C_BLOCKS_XML) -- $(ST_LIB_SRC) -- $(C_BLOCKS_ST)
+
+TESTS += test-xmlexport
