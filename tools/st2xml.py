@@ -374,46 +374,44 @@ def tidy_body(text):
 
 # ---------------------------------------------------------------- values
 
-def split_top(text, sep=","):
-    """Split at depth-0 separators, outside strings."""
-    parts, depth, cur, q = [], 0, "", None
-    for ch in text:
-        if q:
-            cur += ch
-            if ch == q:
-                q = None
+def top_level(text):
+    """(index, char, depth) for each character of text outside string
+    literals; depth counts the open ( and [ before it."""
+    depth, quote, escaped = 0, None, False
+    for k, ch in enumerate(text):
+        if quote:
+            if escaped:
+                escaped = False
+            elif ch == "$":
+                escaped = True
+            elif ch == quote:
+                quote = None
             continue
         if ch in "'\"":
-            q = ch
-        elif ch in "([":
-            depth += 1
-        elif ch in ")]":
+            quote = ch
+            continue
+        if ch in ")]":
             depth -= 1
+        yield k, ch, depth
+        if ch in "([":
+            depth += 1
+
+
+def split_top(text, sep=","):
+    """Split at the separators outside brackets and strings."""
+    parts, start = [], 0
+    for k, ch, depth in top_level(text):
         if ch == sep and depth == 0:
-            parts.append(cur.strip())
-            cur = ""
-        else:
-            cur += ch
-    if cur.strip():
-        parts.append(cur.strip())
+            parts.append(text[start:k].strip())
+            start = k + 1
+    if text[start:].strip():
+        parts.append(text[start:].strip())
     return parts
 
 
 def has_top(text, token):
-    depth, q = 0, None
-    for k, ch in enumerate(text):
-        if q:
-            q = None if ch == q else q
-            continue
-        if ch in "'\"":
-            q = ch
-        elif ch in "([":
-            depth += 1
-        elif ch in ")]":
-            depth -= 1
-        elif depth == 0 and text.startswith(token, k):
-            return True
-    return False
+    """token occurs in text outside brackets and strings."""
+    return any(depth == 0 and text.startswith(token, k) for k, _, depth in top_level(text))
 
 
 def value_element(parent, tag, text):
