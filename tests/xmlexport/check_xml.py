@@ -270,8 +270,10 @@ def c_type_of(t):
     if k == "derived":
         return t[1].upper()
     if k == "array":
-        sizes = [str(int(hi) - int(lo) + 1) for lo, hi in t[1]]
-        return "__ARRAY_OF_%s_%s" % (c_type_of(t[2]), "_".join(sizes))
+        # stc: the size of a dimension from 0, else its bounds (m = minus)
+        dims = [str(int(hi) - int(lo) + 1) if int(lo) == 0 else
+                "%s_%s" % (lo.replace("-", "m"), hi.replace("-", "m")) for lo, hi in t[1]]
+        return "__ARRAY_OF_%s_%s" % (c_type_of(t[2]), "_".join(dims))
     if k == "subrange":
         return c_type_of(t[3])
     raise ValueError(k)
@@ -288,7 +290,7 @@ def init_lines(c, func, lhs_prefix):
         m = re.match(r"\s*for \(LINT (\w+) = (\d+); \1 < (\d+); \1\+\+\) \{", ln)
         if m:
             a = re.match(r"\s*%s([\w.\[\]]+?)\[%s\] = (.*);$" % (re.escape(lhs_prefix), m.group(1)), lines[i + 1])
-            for k in range(int(m.group(2)), int(m.group(3))):
+            for k in range(int(m.group(2)), int(m.group(3))) if a else ():
                 out["%s[%d]" % (a.group(1), k)] = a.group(2)
             i += 3
             continue
@@ -405,6 +407,10 @@ def flat_init(var_type, init, path, types_by_name, out):
             for _ in range(n):
                 flat_init(base, v, "%s.table[%d]" % (path, k), types_by_name, out)
                 k += 1
+    elif var_type[0] == "derived" and var_type[1].upper() not in types_by_name:
+        # a block instance: its inputs' types are not in this file's types
+        for m, v in init[1]:
+            flat_init(("block-input",), v, "%s.%s" % (path, m.upper()), types_by_name, out)
     else:
         members = {m["name"].upper(): m for m in (types_by_name[var_type[1].upper()]["type"][1]
                                                    if var_type[0] == "derived" else var_type[1])}
@@ -487,14 +493,16 @@ def main(argv):
         temps = [v for k, _, vs in p["sections"] if k == "tempVars" for v in vs]
         # VAR_IN_OUT and located variables are pointers in stc's structs
         ptr = {v["name"] for k, _, vs in p["sections"] for v in vs
-               if k == "inOutVars" or v["address"]}
+               if k == "inOutVars" or v["address"]
+               or (k == "outputVars" and p["kind"] == "function")}
         in_struct = variables if p["kind"] == "function" else [v for v in variables if v not in temps]
         expect_members = [(c_type_of(v["type"]) + (" *" if v["name"] in ptr else ""),
                            v["name"].upper()) for v in in_struct]
         if p["kind"] == "function":
             m = re.search(r"^(\w+) %s\(([^)]*)\);" % p["name"].upper(), h, re.M)
             args = [] if not m or m.group(2) in ("", "void") else \
-                [tuple(a.strip().rsplit(" ", 1)) for a in m.group(2).split(",")]
+                [(t + (" *" if star else ""), n) for t, star, n in
+                 re.findall(r"(\w+)\s*(\*?)\s*(\w+)", m.group(2))]
             inits, locs = fn_init(c, p["name"].upper())
             members = args + locs
             rt_ok = m is not None and m.group(1) == c_type_of(p["rtype"])
