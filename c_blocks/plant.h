@@ -33,6 +33,12 @@
 
 #include <stdint.h>
 
+/* C linkage when included from C++ (OpenPLC v3 builds the PLC program with
+** g++); plant.c itself is always compiled as C. */
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct plant_params {
     double maxvel;        /* counts/s at +10 V */
     double lag;           /* s, drive time constant (0 = none) */
@@ -95,5 +101,9 @@ enum {
 };
 /* v[PA_T] < 0 means "not started": the state is initialised first. */
 void plant_step_array(double *v, int16_t dac, double dt);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

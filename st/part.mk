@@ -13,3 +13,5 @@ $(ST_LIB): $(ST_LIB_SRC)
 	cat $(ST_LIB_SRC) > $@
 
 include tests/epicpos/epicpos.mk
+
+include st/export.mk

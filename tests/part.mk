@@ -35,3 +35,5 @@ include tests/isg/isg.mk
 include tests/plcopen/plcopen.mk
 # ---- LJPROF: limited-jerk profiles, closed-form cases and Ruckig ----
 include tests/ljprof/ljprof.mk
+# ---- the library in other environments: C++ linkage, PLCopen XML export ----
+include tests/xmlexport/xmlexport.mk
