@@ -7,6 +7,7 @@ ISG_TESTS := $(wildcard tests/isg/t_*.st)
 ISG_T := $(BUILD)/tests/isg
 
 TESTS += test-isg test-isg-filters
+MATIEC_TESTS += test-isg
 
 .PHONY: test-isg test-isg-filters
 # the APOSSCTL runner builds and runs such programs; its lines relabelled

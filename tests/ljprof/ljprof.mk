@@ -9,6 +9,7 @@ LJPROF_TESTS := $(wildcard tests/ljprof/t_*.st)
 LJPROF_B     := $(BUILD)/tests/ljprof
 
 TESTS += test-ljprof test-ljprof-ruckig test-ljprof-extremes
+MATIEC_TESTS += test-ljprof
 
 .PHONY: test-ljprof test-ljprof-ruckig test-ljprof-extremes
 test-ljprof: $(ST_LIB) $(STC)

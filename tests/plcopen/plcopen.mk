@@ -4,6 +4,7 @@
 PLCOPEN_TESTS := $(wildcard tests/plcopen/t_*.st)
 
 TESTS += test-plcopen
+MATIEC_TESTS += test-plcopen
 
 .PHONY: test-plcopen
 test-plcopen: $(ST_LIB) $(STC)
