@@ -28,3 +28,6 @@ include tests/examples/tests.mk
 
 # ---- apossctl: the APOSS controller part ----
 include tests/apossctl/apossctl.mk
+
+# ---- cam: the CAM curve and the CAM box parts ----
+include tests/cam/cam.mk
