@@ -25,3 +25,11 @@ bench-epicpos: $(STC) $(ST_LIB) $(C_BLOCKS_OBJ) $(PLCRT_MAIN) $(PLCRT_OBJ)
 	  GEN_CFLAGS="$(PLC_GEN_CFLAGS)" CFLAGS="$(CFLAGS)" PLCRT_LINK="$(abspath $(PLCRT_MAIN) $(PLCRT_OBJ))" \
 	  PLCRT_LIBS="$(PLCRT_LIBS)" python3 bench/epicpos/bench.py $(BENCH_B)/epicpos
 BENCHES += bench-epicpos
+
+# CAM curve: ns per evaluation at 1000 fix points; CAM box: ns per scan
+# with 32 cams (bench/cam/)
+.PHONY: bench-cam
+bench-cam: $(STC) $(ST_LIB)
+	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
+	  bench/cam/bench.sh $(BENCH_B)/cam $(abspath $(ST_LIB))
+BENCHES += bench-cam
