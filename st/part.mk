@@ -3,7 +3,7 @@
 # PLC project puts in front of its own program before compiling it.
 ST_LIB_SRC := st/epicutil.st st/epicprof.st st/poscount.st st/pidff.st st/apossctl.st \
               st/prssearch.st st/zlatch.st st/epicpos.st
-ST_LIB_SRC += st/camcurve.st st/cambox.st
+ST_LIB_SRC += st/camcurve.st st/cambox.st st/camsync.st
 ST_LIB     := $(BUILD)/st/epicpos.st
 
 ALL += $(ST_LIB)
