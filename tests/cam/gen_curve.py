@@ -51,7 +51,7 @@ class Prog:
                   % (cv, len(m), cv, endtype, cv, intervals))
         for i in range(len(m)):
             tt = t is not None and t[i]
-            self.line("%s.FIX[%d].M := %s; %s.FIX[%d].S := %s; %s.FIX[%d].T := %s;"
+            self.line("%s.FIX[%d].MASTER := %s; %s.FIX[%d].SLAVE := %s; %s.FIX[%d].TANGENT := %s;"
                       % (cv, i, lit(m[i]), cv, i, lit(s[i]), cv, i, "TRUE" if tt else "FALSE"))
 
     def write(self, path):
@@ -380,7 +380,7 @@ def prog_errors():
     p.ok(4, "c.ERROR AND c.ERRORID = 4 AND c.ERRPOINT = 2", "INT_TO_LREAL(c.ERRPOINT)")
     p.set_curve("cv", [0.0, 1000.0, 2000.0, 3000.0, 4000.0], [0.0, 500.0, 1000.0, 2000.0, 3000.0],
                 [False, True, True, False, False])
-    p.line("cv.FIX[2].S := 1000.0; cv.FIX[3].S := 1500.0;")
+    p.line("cv.FIX[2].SLAVE := 1000.0; cv.FIX[3].SLAVE := 1500.0;")
     build()
     p.ok(13, "NOT c.ERROR AND c.VALID AND NEAR(c.SPOS, 1000.0, 1.0E-9) AND c.SACC = 0.0", "c.SPOS")
     p.set_curve("cv", [0.0, 1000.0, 2000.0, 3000.0, 4000.0], [0.0, 500.0, 1700.0, 2000.0, 3000.0],
@@ -405,7 +405,7 @@ def prog_errors():
     build()
     p.ok(11, "NOT c.ERROR AND c.VALID")
     # rising edge: changing the table while BUILD stays TRUE changes nothing
-    p.line("cv.FIX[2].S := 9999.0;")
+    p.line("cv.FIX[2].SLAVE := 9999.0;")
     p.line("c(BUILD := TRUE, MPOS := 2000.0, CURVE := cv);")
     p.ok(14, "NEAR(c.SPOS, 1800.0, 1.0E-9)", "c.SPOS")
     build()
