@@ -19,26 +19,13 @@ if ! python3 "$here/gen_curve.py" "$out/gen"; then
 fi
 for st in "$out"/gen/t_*.st "$@"; do
     [ -f "$st" ] || continue
-    name=$(basename "$st" .st)
-    d="$out/$name"
+    d="$out/$(basename "$st" .st)"
     rm -rf "$d" && mkdir -p "$d"
     cat "$lib" "$top/tests/epicpos/tsupport.st" "$st" > "$d/all.st"
-    st_compile "$d/all.st" "$d" "cam/$name" || { status=1; continue; }
-    if [ -s "$d/stc.log" ]; then
-        echo "FAIL: cam/$name: the compiler warns:"
-        sed 's/^/    /' "$d/stc.log" | head -20
-        status=1
-    fi
     # the generated programs are long straight-line code: gcc's optimiser
     # takes a minute on them and buys nothing, so they are built with -O0
     opt=()
     case $st in "$out"/gen/*) opt=(-O0) ;; esac
-    st_link "$d" "$here/../epicpos/harness.c" "$d/prog" "cam/$name" "${opt[@]}" || { status=1; continue; }
-    ticks=$(sed -n 's/.*(\* MAXTICKS \([0-9]*\) \*).*/\1/p' "$st" | head -1)
-    # the harness labels its lines for the EPICPOS suite: relabel them
-    timeout 300 "$d/prog" "$st" "${ticks:-100000}" > "$d/out.txt"
-    rc=$?
-    sed 's#^\(PASS\|FAIL\): epicpos/#\1: cam/#' "$d/out.txt"
-    [ $rc -eq 0 ] || status=1
+    st_check_run cam "$st" "$d" "${opt[@]}" || status=1
 done
 exit $status
