@@ -331,6 +331,77 @@ def prog_seed():
     return p
 
 
+def prog_mixed():
+    """Random curves with T segments against scipy, piece by piece."""
+    rng = np.random.default_rng(4242)
+    p = Prog("t_curve_mixed", "CAMCURVE on random curves of C and T points: each run of C "
+             "segments against scipy.interpolate.CubicSpline clamped to the slopes of the T "
+             "segments beside it and, at the cycle ends, to the end type's slope from the "
+             "natural spline of the first and last runs (DESIGN.md section 7); T segments "
+             "against the closed form of a straight line.")
+    p.check(1, "mixed curves: the slave passes through every fix point within 1e-9 UU")
+    p.check(2, "mixed curves: the spline runs equal scipy's clamped splines (position, speed, acceleration)")
+    p.check(3, "mixed curves: T segments straight, SACC 0")
+    p.check(4, "mixed curves: no speed step at any fix point nor across the cycle boundary")
+    p.check(5, "table mode with fix points off the grid: the table samples the spline, linear between")
+    for k, et in enumerate((0, 1, 2, 0, 1, 2)):
+        n = 8 + 4 * k
+        cv = "cv%d" % k
+        c = "c%d" % k
+        p.fbs.append("%s : CAM_CURVE;" % cv)
+        p.fbs.append("%s : CAMCURVE;" % c)
+        m = np.cumsum(rng.uniform(20.0, 200.0, n))
+        s = np.cumsum(rng.uniform(-50.0, 150.0, n))
+        tang = [False] * n
+        # T segments: not the first or last, never two in a row
+        for i in rng.choice(np.arange(2, n - 3), size=max(1, n // 5), replace=False):
+            if not tang[i - 1] and not tang[i + 1]:
+                tang[i] = True
+        ref, v = piecewise_reference(m, s, tang, et)
+        p.set_curve(cv, m, s, tang, endtype=et)
+        p.line("%s(BUILD := TRUE, MPOS := %s, CURVE := %s);" % (c, lit(m[0]), cv))
+        for i in range(n):
+            p.line("%s(MPOS := %s, CURVE := %s);" % (c, lit(m[i]), cv))
+            p.near(1, "%s.SPOSC" % c, s[i], 1e-9)
+        for x in rng.uniform(m[0], m[-1], 40):
+            i = int(np.searchsorted(m, x, side="right") - 1)
+            p.line("%s(MPOS := %s, CURVE := %s);" % (c, lit(x), cv))
+            if tang[i]:
+                d = (s[i + 1] - s[i]) / (m[i + 1] - m[i])
+                p.near(3, "%s.SPOS" % c, s[i] + d * (x - m[i]), 1e-9 * 1e4)
+                p.ok(3, "%s.SACC = 0.0 AND NEAR(%s.SVEL, %s, 1.0E-12)" % (c, c, lit(d)), "%s.SACC" % c)
+            else:
+                p.near(2, "%s.SPOS" % c, ref(x), 1e-9 * 1e4)
+                p.near(2, "%s.SVEL" % c, ref(x, 1), 1e-9)
+                p.near(2, "%s.SACC" % c, ref(x, 2), 1e-10)
+        # the acceleration is linear on each piece: its largest size is at a knot
+        amax = max(abs(ref(x, 2)) for x in list(m[:-1] + 1e-9) + list(m[1:] - 1e-9))
+        for i in list(range(1, n - 1)) + [n - 1]:
+            e = 1e-6
+            p.line("%s(MPOS := %s, CURVE := %s); v1 := %s.SVEL;" % (c, lit(m[i] - e), cv, c))
+            p.line("%s(MPOS := %s, CURVE := %s);" % (c, lit(m[i] + e), cv))
+            # a speed step would be the size of the slopes (0.1 .. 7 UU/MU)
+            p.ok(4, "NEAR(%s.SVEL, v1, %s)" % (c, lit(2 * e * amax * 1.01 + 1e-9)), "%s.SVEL - v1" % c)
+    # table mode, 30 intervals over a 1000 MU cycle: fix points off the grid
+    m = np.array([0.0, 130.0, 410.0, 555.0, 820.0, 1000.0])
+    s = np.array([0.0, 90.0, 300.0, 420.0, 610.0, 700.0])
+    tang = [False, False, True, False, False, False]
+    ref, v = piecewise_reference(m, s, tang, 0)
+    p.fbs.append("cvt : CAM_CURVE;")
+    p.fbs.append("ct : CAMCURVE;")
+    p.set_curve("cvt", m, s, tang, endtype=0, intervals=30)
+    p.line("ct(BUILD := TRUE, MPOS := 0.0, CURVE := cvt);")
+    g = 1000.0 / 30
+    for x in rng.uniform(0.0, 1000.0, 40):
+        j = min(int(x // g), 29)
+        a = ref(j * g)
+        b = ref((j + 1) * g) if j < 29 else s[-1]
+        p.line("ct(MPOS := %s, CURVE := cvt);" % lit(x))
+        p.near(5, "ct.SPOS", a + (x - j * g) / g * (b - a), 1e-9 * 1e3)
+    p.fbs.append("v1 : LREAL;")
+    return p
+
+
 def prog_errors():
     p = Prog("t_curve_errors", "CAMCURVE refuses bad curves with an error code naming the "
              "problem (the header of st/camcurve.st) and keeps the curve in use.")
@@ -416,7 +487,7 @@ def prog_errors():
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
-    for p in (prog_seed(), prog_random(), prog_errors()):
+    for p in (prog_seed(), prog_random(), prog_mixed(), prog_errors()):
         p.write(os.path.join(out, p.name + ".st"))
 
 
