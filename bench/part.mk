@@ -55,3 +55,11 @@ bench-trace: $(BUILD)/plc/bench_trace/plcrt $(BENCH_B)/runtime/tracecost
 	python3 bench/runtime/trace_bench.py $(BUILD)/plc/bench_trace/plcrt $(BENCH_B)/runtime/tracecost \
 	  $(abspath $(BENCH_B))/trace
 BENCHES += bench-trace
+
+# CAM curve: ns per evaluation at 1000 fix points; CAM box: ns per scan
+# with 32 cams (bench/cam/)
+.PHONY: bench-cam
+bench-cam: $(STC) $(ST_LIB)
+	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
+	  bench/cam/bench.sh $(BENCH_B)/cam $(abspath $(ST_LIB))
+BENCHES += bench-cam

@@ -37,3 +37,5 @@ include tests/plcopen/plcopen.mk
 include tests/ljprof/ljprof.mk
 # ---- the library in other environments: C++ linkage, PLCopen XML export ----
 include tests/xmlexport/xmlexport.mk
+# ---- cam: the CAM curve and the CAM box parts ----
+include tests/cam/cam.mk

@@ -32,3 +32,27 @@ st_link() {
         return 1
     fi
 }
+
+# st_check_run SUITE ST DIR [CC flags...]: build DIR/all.st (the program ST
+# with what it needs, already put together by the caller) into DIR/prog with
+# the EPICPOS check harness (tests/epicpos/harness.c), run it for the
+# program's "(* MAXTICKS n *)" ticks and print its PASS/FAIL lines labelled
+# SUITE/name.  A compiler warning is a failure.  Returns 1 on any failure.
+st_check_run() {
+    local suite=$1 st=$2 d=$3 name rc ticks
+    shift 3
+    name=$(basename "$st" .st)
+    st_compile "$d/all.st" "$d" "$suite/$name" || return 1
+    if [ -s "$d/stc.log" ]; then
+        echo "FAIL: $suite/$name: the compiler warns:"
+        sed 's/^/    /' "$d/stc.log" | head -20
+        return 1
+    fi
+    st_link "$d" "$common_dir/../epicpos/harness.c" "$d/prog" "$suite/$name" "$@" || return 1
+    ticks=$(sed -n 's/.*(\* MAXTICKS \([0-9]*\) \*).*/\1/p' "$st" | head -1)
+    # the harness labels its lines for the EPICPOS suite: relabel them
+    timeout 300 "$d/prog" "$st" "${ticks:-100000}" > "$d/out.txt"
+    rc=$?
+    sed "s#^\(PASS\|FAIL\): epicpos/#\1: $suite/#" "$d/out.txt"
+    return $rc
+}
