@@ -9,5 +9,5 @@ ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 
 .PHONY: $(EXAMPLES:%=run-%)
 $(EXAMPLES:%=run-%): run-%: $(BUILD)/plc/%/plcrt
-	$(BUILD)/plc/$*/plcrt -c examples/$*/$*.ini
+	@mk/run_fg.sh $(BUILD)/plc/$*/plcrt -c examples/$*/$*.ini
 RUN_DEMO := run-epicpos
