@@ -28,3 +28,6 @@ include tests/examples/tests.mk
 
 # ---- apossctl: the APOSS controller part ----
 include tests/apossctl/apossctl.mk
+
+# ---- docs/getting-started.md, run as the page says ----
+include tests/getting_started/getting_started.mk

@@ -1,0 +1,11 @@
+# docs/getting-started.md followed block by block (tests/getting_started/
+# run_page.py): a project outside the tree built with plcrt-build, run, moved
+# over Modbus with mbpoll and pymodbus, stopped with Ctrl-C, a compile error
+# named in the user's file. plcrt-build uses the tree's build/.
+GS_T := $(BUILD)/tests/getting_started
+.PHONY: test-getting-started
+test-getting-started: plcrt-parts
+	@rm -rf $(GS_T) && mkdir -p $(GS_T)
+	@mk/suite.sh $(RESULTS) getting-started python3 tests/getting_started/run_page.py \
+	    docs/getting-started.md . $(abspath $(GS_T))
+TESTS += test-getting-started

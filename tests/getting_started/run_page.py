@@ -1,0 +1,186 @@
+#!/usr/bin/env python3
+"""Follow docs/getting-started.md step by step, so that the page cannot rot.
+
+    run_page.py PAGE TREE WORKDIR
+
+Every fenced block of the page is taken in order, in WORKDIR (an empty
+folder, as the page starts from), with PLC set to the source tree:
+
+  ```LANG file=PATH   the block is written to PATH
+  ```sh               run with bash -e; it must succeed
+  ```sh fails         run; it must fail (a compile error the page shows)
+  ```sh wait          run again and again (up to 30 s) until the text block
+                      that follows appears in its output
+  ```sh background    started and left running (plcrt); the next blocks
+                      talk to it
+  ```sh setup         what the reader sets up by hand (PLC=...): not run
+  ```text             lines the previous sh block must print (spaces
+                      compared loosely)
+  ```text ctrl-c      Ctrl-C (SIGINT) to the background job: it must end
+                      with status 0 and print these lines
+
+Shell variables carry from one block to the next, as in one terminal. The
+only liberty taken: the page's Modbus port 1502 becomes a port free now.
+After the page, two checks of plcrt-build's messages the page does not
+show: an error in the first user file, a project without plcrt.ini.
+Prints PASS:/FAIL: lines (mk/suite.sh)."""
+import os
+import re
+import shlex
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from peer import free_port  # noqa: E402
+
+page, tree, work = sys.argv[1], os.path.abspath(sys.argv[2]), os.path.abspath(sys.argv[3])
+port = free_port()
+failed = 0
+
+
+def report(name, ok, why=""):
+    global failed
+    print(("PASS: " if ok else "FAIL: ") + name + ("" if ok else ": " + str(why)[-1500:]), flush=True)
+    failed += not ok
+    return ok
+
+
+def norm(line):
+    return " ".join(line.split())
+
+
+def shows(out, expected):
+    """Every line of expected is a line of out (spaces compared loosely)."""
+    lines = {norm(x) for x in out.splitlines()}
+    missing = [x for x in expected.splitlines() if norm(x) and norm(x) not in lines]
+    return not missing, missing
+
+
+text = open(page).read().replace("1502", str(port))
+blocks = [(m.group(1), m.group(2).strip(), m.group(3))
+          for m in re.finditer(r"^```(\w+)([^\n]*)\n(.*?)^```\s*$", text, re.S | re.M)]
+
+os.makedirs(work, exist_ok=True)
+envfile = os.path.join(work, ".page-env")
+cwdfile = os.path.join(work, ".page-cwd")
+with open(cwdfile, "w") as f:
+    f.write(work)
+env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "V")}
+env["PLC"] = tree
+with open(envfile, "w") as f:
+    f.write("")
+
+
+def sh(code, timeout=120):
+    """Run one block as the next commands typed in the same terminal."""
+    cwd = open(cwdfile).read().strip()
+    script = (f"set -a\n. {shlex.quote(envfile)}\ncd {shlex.quote(cwd)}\nset -e\n{code}\n"
+              f"export -p > {shlex.quote(envfile)}\npwd > {shlex.quote(cwdfile)}\n")
+    p = subprocess.run(["bash", "-c", script], env=env, stdin=subprocess.DEVNULL,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    return p.returncode, p.stdout
+
+
+bg = None          # the background job: (Popen, log path)
+i = 0
+while i < len(blocks):
+    lang, tag, body = blocks[i]
+    nxt = blocks[i + 1] if i + 1 < len(blocks) else None
+    expect = nxt[2] if nxt and nxt[0] == "text" and nxt[1] == "" else None
+    first = body.strip().splitlines()[0] if body.strip() else ""
+    m = re.match(r"file=(\S+)", tag)
+    if m:
+        path = os.path.join(open(cwdfile).read().strip(), m.group(1))
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w") as f:
+            f.write(body)
+        report(f"page block {i}: write {m.group(1)}", True)
+    elif lang == "sh" and tag == "setup":
+        pass
+    elif lang == "sh" and tag in ("", "fails"):
+        rc, out = sh(body)
+        ok = (rc == 0) if tag == "" else (rc != 0)
+        why = f"exit status {rc}: {out}"
+        if ok and expect is not None:
+            ok, why = shows(out, expect)
+            why = f"missing {why} in: {out}"
+        report(f"page block {i}: `{first}`" + (" fails as shown" if tag else ""), ok, why)
+        if expect is not None:
+            i += 1
+    elif lang == "sh" and tag == "wait":
+        end = time.time() + 30
+        while True:
+            rc, out = sh(body)
+            ok, missing = shows(out, expect or "")
+            if (ok and rc == 0) or time.time() > end:
+                break
+            time.sleep(0.3)
+        report(f"page block {i}: `{first}` until it shows {expect.strip()!r}", ok and rc == 0,
+               f"exit status {rc}, missing {missing} in: {out}")
+        i += 1
+    elif lang == "sh" and tag == "background":
+        cwd = open(cwdfile).read().strip()
+        log = os.path.join(work, "background.log")
+        script = f"set -a\n. {shlex.quote(envfile)}\ncd {shlex.quote(cwd)}\n{body}"
+        p = subprocess.Popen(["bash", "-c", script], env=env, stdin=subprocess.DEVNULL,
+                             stdout=open(log, "w"), stderr=subprocess.STDOUT, start_new_session=True)
+        bg = (p, log)
+        end, up = time.time() + 60, False
+        while time.time() < end and p.poll() is None and not up:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=0.2).close()
+                up = True
+            except OSError:
+                time.sleep(0.2)
+        report(f"page block {i}: `{first}` serves Modbus on its port", up,
+               f"status {p.poll()}: {open(log).read()}")
+    elif lang == "text" and tag == "ctrl-c":
+        if not bg:
+            report(f"page block {i}: Ctrl-C", False, "no background job to stop")
+        else:
+            p, log = bg
+            os.killpg(p.pid, signal.SIGINT)
+            try:
+                rc = p.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                rc = p.wait()
+            out = open(log).read()
+            ok, missing = shows(out, body)
+            report(f"page block {i}: Ctrl-C ends plcrt with status 0 and {body.strip()!r}",
+                   ok and rc == 0, f"status {rc}, missing {missing} in: {out[-1500:]}")
+            bg = None
+    else:
+        report(f"page block {i}: ```{lang} {tag}", False, "a block this test does not know how to follow")
+    i += 1
+
+if bg:
+    os.killpg(bg[0].pid, signal.SIGKILL)
+    bg[0].wait()
+
+# ---- beyond the page: where plcrt-build's other messages point ----
+proj = os.path.join(work, "myaxis")
+build = [os.path.join(tree, "plcrt-build"), "myaxis"]
+axis = os.path.join(proj, "axis.st")
+if os.path.exists(axis):
+    src = open(axis).read()
+    lines = src.splitlines(keepends=True)
+    # the line of "go := FALSE;" in the user's first file, found in the text
+    n = next(k for k, line in enumerate(lines) if "go := FALSE;" in line)
+    lines[n] = lines[n].replace("go := FALSE;", "go := FALS;")
+    open(axis, "w").write("".join(lines))
+    p = subprocess.run(build, cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    open(axis, "w").write(src)
+    col = lines[n].index("FALS;") + 1
+    want = f"myaxis/axis.st:{n + 1}:{col}: error:"
+    report(f"an error in the first user file is reported at {want}", p.returncode == 1 and
+           any(x.startswith(want) for x in p.stdout.splitlines()), f"status {p.returncode}: {p.stdout}")
+    os.rename(os.path.join(proj, "plcrt.ini"), os.path.join(proj, "other.ini"))
+    p = subprocess.run(build, cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    os.rename(os.path.join(proj, "other.ini"), os.path.join(proj, "plcrt.ini"))
+    report("a project without plcrt.ini: status 2, the message names myaxis/plcrt.ini",
+           p.returncode == 2 and "myaxis/plcrt.ini" in p.stdout, f"status {p.returncode}: {p.stdout}")
+sys.exit(1 if failed else 0)
