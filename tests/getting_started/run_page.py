@@ -142,6 +142,7 @@ while i < len(blocks):
             report(f"page block {i}: Ctrl-C", False, "no background job to stop")
         else:
             p, log = bg
+            time.sleep(1.2)          # one more status line (status_interval 1 s)
             os.killpg(p.pid, signal.SIGINT)
             try:
                 rc = p.wait(timeout=15)
@@ -149,6 +150,12 @@ while i < len(blocks):
                 os.killpg(p.pid, signal.SIGKILL)
                 rc = p.wait()
             out = open(log).read()
+            # where the axis went, from plcrt's own status lines (the page
+            # sends it to 3000, then back to 0), not from the block's states
+            posits = [int(x) for x in re.findall(r"AX\.POSIT (-?\d+)", out)]
+            there = next((k for k, x in enumerate(posits) if abs(x - 3000) <= 5), None)
+            report("the status lines show the axis at 3000 +/- 5 Um (toll), then back at 0 +/- 5 Um",
+                   there is not None and any(abs(x) <= 5 for x in posits[there:]), posits)
             ok, missing = shows(out, body)
             report(f"page block {i}: Ctrl-C ends plcrt with status 0 and {body.strip()!r}",
                    ok and rc == 0, f"status {rc}, missing {missing} in: {out[-1500:]}")
