@@ -48,7 +48,7 @@ endef
 .PHONY: plcrt-parts
 plcrt-parts: $(STC) $(ST_LIB) $(PLCRT_MAIN) $(PLCRT_OBJ)
 	@{ echo "STC='$(abspath $(STC))'"; echo "STC_INC='$(abspath $(STC_INC))'"; \
-	   echo "ST_LIB='$(abspath $(ST_LIB))'"; echo "GEN_PROGRAM='$(abspath plc_runtime/gen_program.sh)'"; \
+	   echo "ST_LIB_SRC='$(abspath $(ST_LIB_SRC))'"; echo "GEN_PROGRAM='$(abspath plc_runtime/gen_program.sh)'"; \
 	   echo "RT_INC='$(abspath plc_runtime)'"; echo "CC='$(CC)'"; echo "CFLAGS='$(CFLAGS)'"; \
 	   echo "GEN_CFLAGS='$(PLC_GEN_CFLAGS)'"; \
 	   echo "OBJS='$(abspath $(PLCRT_MAIN) $(PLCRT_OBJ))'"; echo "LIBS='$(PLCRT_LIBS)'"; \
