@@ -1,7 +1,8 @@
 # docs/getting-started.md followed block by block (tests/getting_started/
 # run_page.py): a project outside the tree built with plcrt-build, run, moved
 # over Modbus with mbpoll and pymodbus, stopped with Ctrl-C, a compile error
-# named in the user's file. plcrt-build uses the tree's build/.
+# named in the user's file; then the build's one-line-per-step output.
+# plcrt-build uses the tree's build/.
 GS_T := $(BUILD)/tests/getting_started
 .PHONY: test-getting-started
 test-getting-started: plcrt-parts

@@ -211,4 +211,21 @@ if os.path.exists(axis):
     os.rename(os.path.join(proj, "other.ini"), os.path.join(proj, "plcrt.ini"))
     report("a project without plcrt.ini: status 2, the message names myaxis/plcrt.ini",
            p.returncode == 2 and "myaxis/plcrt.ini" in p.stdout, f"status {p.returncode}: {p.stdout}")
+
+# ---- the build's own lines: one short line per step, V=1 the commands ----
+qb = os.path.join(work, "qv")
+obj = os.path.join(qb, "c_blocks", "plant.o")
+outs = {}
+for v in ("0", "1"):
+    if os.path.exists(obj):
+        os.unlink(obj)
+    p = subprocess.run(["make", "--no-print-directory", "-C", tree, f"BUILD={qb}", f"V={v}", obj], env=env,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    outs[v] = (p.returncode, p.stdout)
+report("make: one short line for a compile step (`CC c_blocks/plant.c`)",
+       outs["0"][0] == 0 and [norm(x) for x in outs["0"][1].splitlines()] == ["CC c_blocks/plant.c"], outs["0"])
+report("make V=1: the compiler's command line instead",
+       outs["1"][0] == 0 and any(x.split()[:1] == [os.environ.get("CC", "cc")] and "c_blocks/plant.c" in x
+                                 for x in outs["1"][1].splitlines()) and "CC c_blocks" not in outs["1"][1],
+       outs["1"])
 sys.exit(1 if failed else 0)
