@@ -60,6 +60,7 @@ def shows(out, expected):
     return not missing, missing
 
 
+port_page = port
 text = open(page).read().replace("1502", str(port))
 blocks = [(m.group(1), m.group(2).strip(), m.group(3))
           for m in re.finditer(r"^```(\w+)([^\n]*)\n(.*?)^```\s*$", text, re.S | re.M)]
@@ -69,7 +70,10 @@ envfile = os.path.join(work, ".page-env")
 cwdfile = os.path.join(work, ".page-cwd")
 with open(cwdfile, "w") as f:
     f.write(work)
-env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "V")}
+# the page is followed as a user would, with stc: nothing of a calling
+# make (test-matiec exports COMPILER, BUILD, RESULTS) reaches it
+env = {k: v for k, v in os.environ.items()
+       if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "V", "COMPILER", "BUILD", "RESULTS", "MATIEC_DIR")}
 env["PLC"] = tree
 with open(envfile, "w") as f:
     f.write("")
@@ -211,6 +215,64 @@ if os.path.exists(axis):
     os.rename(os.path.join(proj, "other.ini"), os.path.join(proj, "plcrt.ini"))
     report("a project without plcrt.ini: status 2, the message names myaxis/plcrt.ini",
            p.returncode == 2 and "myaxis/plcrt.ini" in p.stdout, f"status {p.returncode}: {p.stdout}")
+
+# ---- with upstream matiec (make test-matiec, MATIEC_DIR set): the same
+# project built by plcrt-build COMPILER=matiec, errors in the user's files,
+# and the axis moved ----
+mdir = os.environ.get("MATIEC_DIR", "")
+if mdir and os.path.exists(axis):
+    menv = dict(env, COMPILER="matiec", MATIEC_DIR=mdir)
+
+    def mbuild():
+        return subprocess.run(build, cwd=work, env=menv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                              text=True, timeout=300)
+    cfg = os.path.join(proj, "config.st")
+    csrc = open(cfg).read()
+    open(cfg, "w").write(csrc.replace(": OneAxis;", ": OneAxes;"))
+    p = mbuild()
+    open(cfg, "w").write(csrc)
+    cl = next(k for k, x in enumerate(csrc.splitlines()) if ": OneAxis;" in x) + 1
+    report(f"matiec: an error in the second user file is reported at myaxis/config.st:{cl}",
+           p.returncode == 1 and any(x.startswith(f"myaxis/config.st:{cl}") for x in p.stdout.splitlines()),
+           p.stdout)
+    open(axis, "w").write(src.replace("go := FALSE;", "go := FALS;"))
+    p = mbuild()
+    open(axis, "w").write(src)
+    al = next(k for k, x in enumerate(src.splitlines()) if "go := FALSE;" in x) + 1
+    report(f"matiec: an error in the first user file is reported at myaxis/axis.st:{al}",
+           p.returncode == 1 and any(x.startswith(f"myaxis/axis.st:{al}-") for x in p.stdout.splitlines()),
+           p.stdout)
+    p = mbuild()
+    report("matiec: the page's project builds into myaxis/build-matiec/plcrt",
+           p.returncode == 0 and os.path.exists(os.path.join(proj, "build-matiec", "plcrt")), p.stdout)
+    if p.returncode == 0:
+        port = free_port()
+        ini = os.path.join(proj, "matiec.ini")
+        open(ini, "w").write(open(os.path.join(proj, "plcrt.ini")).read().replace("port = 1502", f"port = {port}")
+                             .replace(f"port = {port_page}", f"port = {port}"))
+        q = subprocess.Popen([os.path.join("build-matiec", "plcrt"), "-c", "matiec.ini"], cwd=proj,
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        from pymodbus.client import ModbusTcpClient
+        c = ModbusTcpClient("127.0.0.1", port=port)
+        end = time.time() + 10
+        while not c.connect() and time.time() < end:
+            time.sleep(0.1)
+        x0 = sim_position()
+        c.write_registers(10000, [0, 1500], slave=1)    # target := 1500 Um
+        c.write_coil(10000, True, slave=1)              # go
+        end, x = time.time() + 15, None
+        while time.time() < end:
+            x = sim_position()
+            if isinstance(x, int) and abs(x - 1500) <= 5:
+                time.sleep(0.3)
+                x = sim_position()
+                break
+            time.sleep(0.1)
+        c.close()
+        q.send_signal(signal.SIGTERM)
+        rc = q.wait(timeout=10)
+        report(f"matiec: the axis moves from {x0} to 1500 +/- 5 counts and stays; SIGTERM: status 0",
+               isinstance(x, int) and abs(x - 1500) <= 5 and rc == 0, f"plant at {x}, status {rc}")
 
 # ---- the build's own lines: one short line per step, V=1 the commands ----
 qb = os.path.join(work, "qv")
