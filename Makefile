@@ -10,6 +10,17 @@ STC     := $(BUILD)/stc/stc
 STC_INC := stc/include
 RESULTS := $(BUILD)/results
 
+# One short line per build step (`CC plc_runtime/scan.c`); `make V=1` shows
+# the commands instead. A rule writes $(call say,CC,what) then $(Q)command.
+V ?= 0
+ifeq ($(V),1)
+Q   :=
+say  = @true
+else
+Q   := @
+say  = @printf '  %-4s %s\n' '$(1)' '$(2)'
+endif
+
 # make test-matiec: the suites of MATIEC_TESTS built again with upstream
 # matiec's iec2c (MATIEC_DIR: where it was built by hand, outside this
 # tree; docs/stc.md) in build-matiec/, to show both compilers give the same
@@ -59,10 +70,15 @@ test-matiec:
 	  RESULTS=build-matiec/results $(MATIEC_TESTS) || touch build-matiec/results/.make-failed
 	@mk/summary.sh build-matiec/results
 
+# make run PROJECT=dir: build and run a project outside the tree (plcrt-build)
 run:
 	@mk/deps.sh
+ifeq ($(PROJECT),)
 	@$(MAKE) --no-print-directory all
 	@$(MAKE) --no-print-directory $(RUN_DEMO)
+else
+	@./plcrt-build --run $(PROJECT)
+endif
 
 bench:
 	@mk/deps.sh

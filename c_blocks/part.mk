@@ -5,4 +5,5 @@ C_BLOCKS_OBJ := $(BUILD)/c_blocks/plant.o
 
 $(BUILD)/c_blocks/%.o: c_blocks/%.c c_blocks/%.h
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) -c $< -o $@
+	$(call say,CC,$<)
+	$(Q)$(CC) $(CFLAGS) -c $< -o $@

@@ -1,5 +1,7 @@
 # Example PLC projects, each linked into its own plcrt (build/plc/NAME/plcrt).
-# `make run` starts the EPICPOS example; `make run-EXAMPLE` starts another.
+# `make run` starts the EPICPOS example; `make run-EXAMPLE` starts another
+# (INI=file: with another configuration). Ctrl-C reaches plcrt alone
+# (mk/run_fg.sh): it stops cleanly and make ends without "Interrupt".
 $(eval $(call plcrt_program,demo,examples/demo/demo.st))
 $(eval $(call plcrt_program,epicpos,$(ST_LIB) examples/epicpos/epicpos.st))
 $(eval $(call plcrt_program,multiaxis,$(ST_LIB) examples/multiaxis/multiaxis.st))
@@ -10,5 +12,5 @@ ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 
 .PHONY: $(EXAMPLES:%=run-%)
 $(EXAMPLES:%=run-%): run-%: $(BUILD)/plc/%/plcrt
-	$(BUILD)/plc/$*/plcrt -c examples/$*/$*.ini
+	@mk/run_fg.sh $(BUILD)/plc/$*/plcrt -c $(or $(INI),examples/$*/$*.ini)
 RUN_DEMO := run-epicpos

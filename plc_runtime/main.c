@@ -160,8 +160,11 @@ static int configure(plc_config *cfg, const char *file, const plc_program *prog,
 /* Stop the scan and the Modbus server (a request in flight gets its reply),
 ** land what clients were told was written (so that a retained value is the
 ** last one acknowledged), then the outputs to their safe state: nothing
-** lands in them after that. Save, print the statistics, release. */
-static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc_config *cfg, retained *ret)
+** lands in them after that. Save, release, and say so in one line; after
+** SIGTERM (a service manager, a test) the statistics are printed too, after
+** Ctrl-C (SIGINT, a person at the terminal) only that line. */
+static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc_config *cfg, retained *ret,
+                      int sig)
 {
     atomic_store(&sc->stop, 1);
     pthread_join(th, NULL);
@@ -173,10 +176,17 @@ static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc
     memset(plc_img.qd, 0, sizeof plc_img.qd);
     memset(plc_img.ql, 0, sizeof plc_img.ql);
     cfg->io->safe_state(cfg->io_state, &plc_img);
+    uint64_t errs = atomic_load(&sc->retain_errors);
     retain_now(sc, ret, cfg, 0);
-    stats_print(stderr, &sc->stats, sc->period_ns);
+    if (sig != SIGINT) stats_print(stderr, &sc->stats, sc->period_ns);
     cfg->io->close(cfg->io_state);
     mb_free(mb);
+    if (!cfg->retain_file[0] || !ret->n)
+        fprintf(stderr, "plcrt: outputs safe (DAC 0 V), nothing retained\n");
+    else if (atomic_load(&sc->retain_errors) != errs)
+        fprintf(stderr, "plcrt: outputs safe (DAC 0 V), retain NOT saved to %s (see above)\n", cfg->retain_file);
+    else
+        fprintf(stderr, "plcrt: outputs safe (DAC 0 V), retain saved to %s\n", cfg->retain_file);
 }
 
 int main(int argc, char **argv)
@@ -311,6 +321,7 @@ int main(int argc, char **argv)
     /* housekeeping */
     uint64_t t_status = scan_now_ns(), t_retain = t_status, t_over = t_status;
     uint64_t last_over = 0;
+    int stop_sig = SIGTERM;
     uint8_t sbuf[CFG_MAX_STATUS][64];
     scan_sample ss[CFG_MAX_STATUS];
     for (int i = 0; i < cfg.nstatus; i++)
@@ -319,7 +330,9 @@ int main(int argc, char **argv)
         struct timespec to = { 0, 200000000 };
         int sig = sigtimedwait(&sigs, NULL, &to);
         if (sig == SIGINT || sig == SIGTERM) {
-            plc_log(LOG_INFO, "%s: stopping", sig == SIGINT ? "SIGINT" : "SIGTERM");
+            if (sig == SIGTERM) plc_log(LOG_INFO, "SIGTERM: stopping");
+            else if (isatty(2)) fputc('\n', stderr);   /* past the terminal's ^C */
+            stop_sig = sig;
             break;
         }
         if (sig == SIGUSR1) stats_print(stderr, &sc.stats, period);
@@ -363,7 +376,7 @@ int main(int argc, char **argv)
         }
     }
 
-    shut_down(&sc, th, srv, mb, &cfg, &ret);
+    shut_down(&sc, th, srv, mb, &cfg, &ret, stop_sig);
     tb_free(tb);
     force_free(fo);
     trace_free(tr);

@@ -11,7 +11,8 @@ ALL += $(ST_LIB)
 
 $(ST_LIB): $(ST_LIB_SRC)
 	@mkdir -p $(@D)
-	cat $(ST_LIB_SRC) > $@
+	$(call say,CAT,$@)
+	$(Q)cat $(ST_LIB_SRC) > $@
 
 include tests/epicpos/epicpos.mk
 

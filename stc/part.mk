@@ -8,10 +8,12 @@ ALL += $(STC_BIN)
 
 $(BUILD)/stc/%.o: stc/%.c stc/stc.h
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(STC_DEFS) -c -o $@ $<
+	$(call say,CC,$<)
+	$(Q)$(CC) $(CFLAGS) $(STC_DEFS) -c -o $@ $<
 
 $(STC_BIN): $(STC_OBJS)
-	$(CC) $(CFLAGS) -o $@ $^ -lm
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lm
 
 # ---- unit tests of the compiler's stages (Check), plain and sanitized ----
 STC_LIB_OBJS := $(filter-out $(BUILD)/stc/main.o,$(STC_OBJS))
@@ -20,15 +22,18 @@ CHECK_LIBS := $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubu
 
 $(BUILD)/stc-san/%.o: stc/%.c stc/stc.h
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SAN) -O1 -c -o $@ $<
+	$(call say,CC,$< (sanitized))
+	$(Q)$(CC) $(CFLAGS) $(SAN) -O1 -c -o $@ $<
 
 $(BUILD)/tests/check_stc: tests/stc_unit/check_stc.c $(STC_LIB_OBJS)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -o $@ $^ $(CHECK_LIBS) -lm
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(CHECK_LIBS) -lm
 
 $(BUILD)/tests/check_stc_san: tests/stc_unit/check_stc.c $(STC_SAN_OBJS)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SAN) -O1 -o $@ $^ $(CHECK_LIBS) -lm
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) $(SAN) -O1 -o $@ $^ $(CHECK_LIBS) -lm
 
 .PHONY: test-stc-unit test-stc-unit-san test-stc-fuzz bench-stc fuzz-stc
 TESTS += test-stc-unit test-stc-unit-san test-stc-fuzz
@@ -41,7 +46,8 @@ test-stc-unit-san: $(BUILD)/tests/check_stc_san
 FUZZ_CC := clang
 $(BUILD)/fuzz/fuzz_stc: tests/fuzz/fuzz_stc.c $(STC_SRCS) stc/stc.h
 	@mkdir -p $(dir $@)
-	$(FUZZ_CC) -g -O1 -std=c11 -D_DEFAULT_SOURCE -fsanitize=fuzzer,address,undefined -o $@ tests/fuzz/fuzz_stc.c $(filter-out stc/main.c,$(STC_SRCS)) -lm
+	$(call say,CC,$@ (libFuzzer))
+	$(Q)$(FUZZ_CC) -g -O1 -std=c11 -D_DEFAULT_SOURCE -fsanitize=fuzzer,address,undefined -o $@ tests/fuzz/fuzz_stc.c $(filter-out stc/main.c,$(STC_SRCS)) -lm
 
 FUZZ_RUN = mkdir -p $(BUILD)/fuzz/corpus && ASAN_OPTIONS=detect_leaks=0 $(BUILD)/fuzz/fuzz_stc \
 	-rss_limit_mb=2048 -timeout=5 -max_len=4096 -artifact_prefix=$(BUILD)/fuzz/ \

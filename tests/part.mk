@@ -39,3 +39,5 @@ include tests/ljprof/ljprof.mk
 include tests/xmlexport/xmlexport.mk
 # ---- cam: the CAM curve and the CAM box parts ----
 include tests/cam/cam.mk
+# ---- docs/getting-started.md, run as the page says ----
+include tests/getting_started/getting_started.mk

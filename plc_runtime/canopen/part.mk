@@ -11,17 +11,21 @@ CO_TSRC  := $(wildcard tests/canopen/test_*.c)
 
 $(CO_BUILD)/%.o: $(CO_DIR)/%.c $(CO_HDR)
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) -c $< -o $@
+	$(call say,CC,$<)
+	$(Q)$(CC) $(CFLAGS) -c $< -o $@
 
 $(CO_LIB): $(CO_OBJ)
-	rm -f $@ && ar rcs $@ $^
+	$(call say,AR,$@)
+	$(Q)rm -f $@ && ar rcs $@ $^
 
 $(CO_BUILD)/test_co: $(CO_TSRC) $(CO_LIB) $(CO_HDR)
-	$(CC) $(CFLAGS) -I$(CO_DIR) $(CO_TSRC) $(CO_LIB) -o $@ $$(pkg-config --cflags --libs check)
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) -I$(CO_DIR) $(CO_TSRC) $(CO_LIB) -o $@ $$(pkg-config --cflags --libs check)
 
 $(CO_BUILD)/test_co_san: $(CO_TSRC) $(CO_SRC) $(CO_HDR)
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) $(SAN) -I$(CO_DIR) $(CO_TSRC) $(CO_SRC) -o $@ $$(pkg-config --cflags --libs check)
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) $(SAN) -I$(CO_DIR) $(CO_TSRC) $(CO_SRC) -o $@ $$(pkg-config --cflags --libs check)
 
 ALL += $(CO_LIB) $(CO_BUILD)/test_co $(CO_BUILD)/test_co_san
 
@@ -34,7 +38,8 @@ TESTS += canopen_unit canopen_unit_san
 
 # stand-alone master on the core, for the bus tests and the benchmarks
 $(CO_BUILD)/co_testmaster: tests/canopen/co_testmaster.c $(CO_LIB) $(CO_HDR)
-	$(CC) $(CFLAGS) -I$(CO_DIR) $< $(CO_LIB) -o $@
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) -I$(CO_DIR) $< $(CO_LIB) -o $@
 ALL += $(CO_BUILD)/co_testmaster
 
 # real-bus tests: a kernel with CAN (User-Mode Linux, or QEMU where UML
@@ -44,14 +49,18 @@ ALL += $(CO_BUILD)/co_testmaster
 # which lets it boot on hosts with a large XSAVE area (AMX).
 $(CO_BUILD)/xstate_shim.so: tests/canopen/xstate_shim.c
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) -shared -fPIC $< -o $@ -ldl
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) -shared -fPIC $< -o $@ -ldl
 $(CO_BUILD)/xstate_guest: tests/canopen/xstate_guest.c
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) $< -o $@
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) $< -o $@
 $(CO_BUILD)/check_xstate: tests/canopen/check_xstate.c tests/canopen/xstate_shim.c
-	$(CC) $(CFLAGS) $^ -o $@ -ldl $$(pkg-config --cflags --libs check)
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) $^ -o $@ -ldl $$(pkg-config --cflags --libs check)
 $(CO_BUILD)/check_xstate_san: tests/canopen/check_xstate.c tests/canopen/xstate_shim.c
-	$(CC) $(CFLAGS) $(SAN) $^ -o $@ -ldl $$(pkg-config --cflags --libs check)
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) $(SAN) $^ -o $@ -ldl $$(pkg-config --cflags --libs check)
 ALL += $(CO_BUILD)/xstate_shim.so $(CO_BUILD)/xstate_guest $(CO_BUILD)/check_xstate \
        $(CO_BUILD)/check_xstate_san
 
@@ -76,20 +85,23 @@ TESTS += canopen_bus
 ifneq ($(wildcard plc_runtime/io_backend.h),)
 $(CO_BUILD)/io_canopen.o: $(CO_DIR)/io_canopen.c $(CO_HDR) $(wildcard plc_runtime/*.h)
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) -Iplc_runtime -I$(CO_DIR) -c $< -o $@
+	$(call say,CC,$<)
+	$(Q)$(CC) $(CFLAGS) -Iplc_runtime -I$(CO_DIR) -c $< -o $@
 CO_BACKEND := $(CO_BUILD)/io_canopen.o $(CO_LIB)
 endif
 
 # benchmarks: SYNC-to-RPDO latency, PDO throughput, bus load (bench/canopen)
 $(CO_BUILD)/co_bench: bench/canopen/co_bench.c
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS) $< -o $@ -lm
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) $< -o $@ -lm
 ALL += $(CO_BUILD)/co_bench
 .PHONY: bench_canopen
 bench_canopen: $(CO_BUILD)/co_bench $(CO_BUILD)/co_testmaster
 	@bench/canopen/run.sh $(CO_BUILD)
 BENCHES += bench_canopen
 $(CO_BUILD)/co_core_bench: bench/canopen/co_core_bench.c $(CO_LIB) $(CO_HDR)
-	$(CC) $(CFLAGS) -I$(CO_DIR) $< $(CO_LIB) -o $@
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) -I$(CO_DIR) $< $(CO_LIB) -o $@
 ALL += $(CO_BUILD)/co_core_bench
 bench_canopen: $(CO_BUILD)/co_core_bench

@@ -429,6 +429,56 @@ def t_param_range(m):
            pe == 0 and s["toll"] and abs(posit - quota2) <= 5, f"parerr {pe}, posit {posit}, quota {quota2}")
 
 
+PARNAME = 1024       # holding 1024..1031 (%MW0..%MW7): parname, 2 characters per register
+
+
+def parname(m):
+    return b"".join(r.to_bytes(2, "big") for r in m.regs(PARNAME, 8)).rstrip(b"\0").decode()
+
+
+def t_param_beyond_int(m):
+    """pgain 40000 (seed: valid 0..32767) written to its 32-bit register must
+    not be clamped to a valid 32767 on the way: EPICPOS reports it, by index
+    (18, the seed's table order) and by name, readable over Modbus."""
+    base = m.md(POSIT)
+    quota = base + 1500
+    pgain0, taccdec0 = m.md(P["pgain"]), m.md(P["taccdec"])
+    m.set_md(P["pgain"], 40000)
+    time.sleep(0.05)
+    pe, name = m.md(PARERR), parname(m)
+    report("epicpos: pgain 40000 (out of 0..32767) reaches EPICPOS: parerr 18, parname 'pgain' "
+           "in holding 1024..1031", pe == 18 and name == "pgain", f"parerr {pe}, parname {name!r}")
+    setup, cmds = readme_commands()
+    line = next((c for d, c in cmds.items() if d.startswith("parname")), None)
+    if setup and line:
+        script = setup.replace("-p 1502", f"-p {m.c.comm_params.port}") + "\n" + line
+        r = subprocess.run(["bash", "-c", script], capture_output=True, text=True, timeout=20)
+        words = [int(v, 16) for v in re.findall(r"^\[\d+\]:\s+0x([0-9A-Fa-f]+)", r.stdout, re.M)]
+        got = b"".join(w.to_bytes(2, "big") for w in words).rstrip(b"\0")
+        report("epicpos: README: the mbpoll line for parname reads 'pgain' in ASCII", got == b"pgain",
+               f"{got!r}: {r.stdout[-300:]}")
+    else:
+        report("epicpos: README: an mbpoll line for parname", False, cmds)
+    n, code, parerr, dx, dp, _, _ = refused_start(m, quota, "pgain")
+    report("epicpos: START with pgain 40000 is refused: refcnt +1, refcode 4, parerr 18, no move",
+           n == 1 and code == 4 and parerr == 18 and dx <= 5 and dp <= 5,
+           f"refcnt +{n}, refcode {code}, parerr {parerr}, plant moved {dx}, posit moved {dp}")
+    m.set_md(P["taccdec"], -70000)   # beyond INT the other way (seed: 0..999)
+    m.set_md(P["pgain"], pgain0)
+    time.sleep(0.05)
+    pe, name = m.md(PARERR), parname(m)
+    report("epicpos: taccdec -70000: parerr 11, parname 'taccdec'", pe == 11 and name == "taccdec",
+           f"parerr {pe}, parname {name!r}")
+    m.set_md(P["taccdec"], taccdec0)
+    time.sleep(0.05)
+    pe, name = m.md(PARERR), parname(m)
+    report(f"epicpos: parameters back (pgain {pgain0}, taccdec {taccdec0}): parerr 0, parname empty", pe == 0 and name == "",
+           f"parerr {pe}, parname {name!r}")
+    s, posit = move(m, quota, 6.0)
+    report("epicpos: and START reaches the quota", s["toll"] and abs(posit - quota) <= 5,
+           f"posit {posit}, quota {quota}")
+
+
 def t_emergency(m):
     base = m.md(POSIT)
     quota = base - 3000
@@ -671,6 +721,7 @@ def main_session():
     run("epicpos: manual inputs", t_manual, m)
     run("epicpos: STOP input", t_stop_input, m)
     run("epicpos: parameter range", t_param_range, m)
+    run("epicpos: parameter beyond INT", t_param_beyond_int, m)
     run("epicpos: emergency", t_emergency, m)
     run("epicpos: following error", t_following_error, m)
     run("epicpos: command coils", t_command_coil, m)

@@ -15,3 +15,12 @@ test-examples: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/multiaxis/plcrt $(BUILD)/
 	exit $$rc
 TESTS += test-examples
 MATIEC_TESTS += test-examples
+
+# Ctrl-C typed at `make run-epicpos` in a terminal (a pseudo-terminal): one
+# line, status 0, no "Interrupt" from make.
+.PHONY: test-examples-ctrl-c
+test-examples-ctrl-c: $(BUILD)/plc/epicpos/plcrt
+	@rm -rf $(BUILD)/tests/ctrl-c
+	@mk/suite.sh $(RESULTS) examples-ctrl-c python3 tests/examples/test_ctrl_c.py . \
+	    examples/epicpos/epicpos.ini $(abspath $(BUILD))/tests/ctrl-c
+TESTS += test-examples-ctrl-c
