@@ -250,8 +250,9 @@ def c_structs(h):
     """name -> [(C type, member)] for every typedef struct in POUS.h."""
     out = {}
     for m in re.finditer(r"typedef struct (\w+)? ?\{\n(.*?)\} (\w+);", h, re.S):
+        # a block instance passed VAR_IN_OUT is a "struct NAME *" member
         out[m.group(3)] = [(t.strip(), n) for t, n in
-                           re.findall(r"^\s+(\w+ ?\*?)\s*(\w+)(?:\[\d+\])?;", m.group(2), re.M)]
+                           re.findall(r"^\s+(?:struct )?(\w+ ?\*?)\s*(\w+)(?:\[\d+\])?;", m.group(2), re.M)]
     return out
 
 
@@ -315,7 +316,7 @@ def fn_init(c, name, body=False):
         return {}, []
     body = m.group(1)
     pre, _, post = body.partition("BOOL retain = 0;")
-    post = post.replace("(void)retain;", "", 1)
+    post = post.partition("(void)retain;")[0]   # the initial values end there; the body follows
     locals_ = re.findall(r"^\s+(\w+) (\w+);$", pre, re.M)
     prologue = []
     for ln in post.split("\n"):
