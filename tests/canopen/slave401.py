@@ -254,6 +254,32 @@ class CanDump:
                     out.append((float(parts[0].strip("()")), bytes.fromhex(data)))
         return out
 
+    def outputs_after_loss(self, node, t_stop, cob_ids):
+        """How the master made node's outputs safe, read from the bus itself
+        (kernel timestamps, whatever the speed of the script): the node's last
+        operational heartbeat before t_stop (time.time() when its heartbeat
+        was stopped), and for each COB-ID the first frame after it from which
+        every frame up to the node's next boot-up is all zeros. Returns (last
+        heartbeat or None, seconds from it to the latest such first zero frame
+        or None if some COB-ID never turned to zeros, frames seen)."""
+        hb = self.frames(0x700 + node)
+        beats = [t for t, d in hb if d == b"\x05" and t < t_stop]
+        if not beats:
+            return None, None, 0
+        last = beats[-1]
+        boot = min([t for t, d in hb if d == b"\x00" and t > t_stop], default=float("inf"))
+        worst, seen = 0.0, 0
+        for cid in cob_ids:
+            fr = [(t, d) for t, d in self.frames(cid) if last < t < boot]
+            seen += len(fr)
+            k = len(fr)
+            while k > 0 and not any(fr[k - 1][1]):
+                k -= 1
+            if k == len(fr):
+                return last, None, seen
+            worst = max(worst, fr[k][0] - last)
+        return last, worst, seen
+
     def close(self, keep):
         self.stop()
         if keep:
