@@ -5,12 +5,14 @@ under the same load (bench/runtime/mbload.c), and the runtime's own cost per
 cycle.
 
 usage: bench.py PLCRT_1MS PLCRT_250US PORT|auto WORKDIR REFSERVER MBLOAD
-(auto: a port free now). BENCH_ONLY=modbus runs the Modbus part alone."""
+(auto: a port free now). BENCH_ONLY=modbus runs the Modbus part alone,
+BENCH_ONLY=idle the 1000 idle connections alone."""
 import os
 import re
 import signal
 import statistics
 import socket
+import struct
 import subprocess
 import sys
 import time
@@ -207,13 +209,96 @@ def cost(st_mb):
               f"{ir / max(st['cycles'], 1):8.0f}  ({st['cycles']} cycles)")
 
 
+def rss_kb(pid):
+    with open(f"/proc/{pid}/status") as f:
+        return int(re.search(r"^VmRSS:\s+(\d+)", f.read(), re.M).group(1))
+
+
+def fc3_latencies(n=400):
+    """n FC3 requests (10 registers) from one working client, one after the
+    other: their round trips in ms."""
+    s = socket.create_connection(("127.0.0.1", PORT), timeout=5)
+    s.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    out = []
+    for i in range(n):
+        req = struct.pack(">HHHBBHH", i & 0xFFFF, 0, 6, 1, 3, 0, 10)
+        t0 = time.perf_counter()
+        s.sendall(req)
+        got = b""
+        while len(got) < 9 + 20:
+            chunk = s.recv(64)
+            if not chunk:
+                raise RuntimeError("connection closed")
+            got += chunk
+        out.append((time.perf_counter() - t0) * 1000)
+    s.close()
+    return out
+
+
+def clients_connected():
+    """Input registers 1048-1049: Modbus clients connected (docs/modbus.md)."""
+    s = socket.create_connection(("127.0.0.1", PORT), timeout=5)
+    s.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 4, 1048, 2))
+    got = b""
+    while len(got) < 13:
+        got += s.recv(64)
+    s.close()
+    hi, lo = struct.unpack(">HH", got[9:13])
+    return (hi << 16 | lo) - 1   # less this request's own connection
+
+
+def idle_connections(n=998, rounds=3):
+    """Target: 1000 connections (998 idle ones, a working client and the
+    diagnostics reader, at
+    max_clients 1000) cost less than 50 MB and delay the working
+    client by less than 1 ms (median round trip, with them against without;
+    medians of `rounds` rounds)."""
+    import resource
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    resource.setrlimit(resource.RLIMIT_NOFILE, (max(soft, min(hard, n + 256)), hard))
+    p = start(P1, ini(prio=0, clients=n))
+    wait_port()
+    time.sleep(0.5)
+    base_rss, med0, med1, extra, held, total = [], [], [], [], [], []
+    try:
+        for _ in range(rounds):
+            r0 = rss_kb(p.pid)
+            med0.append(statistics.median(fc3_latencies()))
+            socks = [socket.create_connection(("127.0.0.1", PORT), timeout=5) for _ in range(n)]
+            time.sleep(1.0)
+            held.append(clients_connected())
+            total.append(rss_kb(p.pid) / 1024)
+            extra.append((rss_kb(p.pid) - r0) / 1024)
+            med1.append(statistics.median(fc3_latencies()))
+            for c in socks:
+                c.close()
+            time.sleep(0.5)
+            base_rss.append(r0 / 1024)
+    finally:
+        stop(p)
+    mem, d = statistics.median(extra), statistics.median(med1) - statistics.median(med0)
+    print(f"\n{n} idle Modbus connections + 1 working (plcrt at 1 ms, {rounds} rounds, medians):")
+    print(f"  connections held by plcrt: {min(held)}..{max(held)} of {n}")
+    tot = statistics.median(total)
+    print(f"  plcrt's resident memory {statistics.median(base_rss):.1f} MB without them, {tot:.1f} MB "
+          f"with them (+{mem:.2f} MB; the client table is sized for max_clients at start) "
+          f"(target < 50 MB): {'met' if tot < 50 else 'NOT met'}")
+    print(f"  working client's FC3 round trip {statistics.median(med0):.3f} ms without, "
+          f"{statistics.median(med1):.3f} ms with them: +{d:.3f} ms (target < 1 ms): "
+          f"{'met' if d < 1.0 else 'NOT met'}")
+
+
 def main():
     if os.environ.get("BENCH_ONLY") == "modbus":
         modbus()
         return
+    if os.environ.get("BENCH_ONLY") == "idle":
+        idle_connections()
+        return
     st1 = latency(P1, 1000)
     latency(P250, 250)
     modbus()
+    idle_connections()
     cost(st1)
 
 
