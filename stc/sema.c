@@ -1864,6 +1864,13 @@ static void mark_used(Ctx *c, Pou *p) {
     }
 }
 
+/* " (first declared in FILE:LINE)" when an earlier declaration of a name is
+** in another input file the user wrote, else "". */
+static const char *declared_elsewhere(const Sym *old, Loc here) {
+    if (!old || !old->loc.src || old->loc.src == here.src || old->loc.src->name[0] == '<') return "";
+    return fmt(" (first declared in %s:%d)", old->loc.src->name, old->loc.line);
+}
+
 void sema(Unit *u) {
     for (size_t i = 0; i < sizeof prims / sizeof prims[0]; i++)
         ty_prim[prims[i].k] = new_type(prims[i].k, prims[i].name, prims[i].cname);
@@ -1872,7 +1879,7 @@ void sema(Unit *u) {
     for (int i = 0; i < u->types.n; i++) {
         TypeDecl *d = u->types.v[i];
         if (prim_named(d->uname, strlen(d->uname)) || find(&c.types, d->uname)) {
-            error_at(d->loc, "duplicate declaration of '%s'", d->name);
+            error_at(d->loc, "duplicate declaration of '%s'%s", d->name, declared_elsewhere(find(&c.types, d->uname), d->loc));
             continue;
         }
         Sym *s = new_sym(SK_TYPE, d->name, d->uname, d->loc);
@@ -1882,7 +1889,8 @@ void sema(Unit *u) {
     for (int i = 0; i < u->pous.n; i++) {
         Pou *p = u->pous.v[i];
         if (find(&c.pous, p->uname) || find(&c.types, p->uname) || prim_named(p->uname, strlen(p->uname))) {
-            error_at(p->loc, "duplicate declaration of '%s'", p->name);
+            Sym *old = find(&c.pous, p->uname);
+            error_at(p->loc, "duplicate declaration of '%s'%s", p->name, declared_elsewhere(old ? old : find(&c.types, p->uname), p->loc));
             continue;
         }
         const char *us = strstr(p->uname, "_TO_");

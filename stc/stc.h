@@ -281,6 +281,8 @@ int codegen(Unit *u, const char *outdir);   /* outdir NULL: generate, write noth
 
 /* ---- the whole pipeline (compile.c): 0 on success, 1 after errors ---- */
 int stc_compile(const Source *src, const char *outdir);
+/* Several files, one program: declarations of each are visible in all. */
+int stc_compile_files(const Source *srcs, int nsrcs, const char *outdir);
 
 Type *canon(Type *t);              /* through aliases and subranges */
 
