@@ -293,9 +293,35 @@ static const char *math_fn(int id) {
 
 static Node *arg(Node *n, int i) { return ((Node *)n->list.v[i])->lhs; }
 
+/* The C helper of <from>_TO_STRING (matiec's formats). */
+static const char *to_string_fn(const Type *from) {
+    switch (from->kind) {
+    case T_BOOL: return "__bool_to_str";
+    case T_BYTE: case T_WORD: case T_DWORD: case T_LWORD: return "__bits_to_str";
+    case T_SINT: case T_INT: case T_DINT: case T_LINT: return "__sint_to_str";
+    case T_REAL: case T_LREAL: return "__real_to_str";
+    case T_TIME: return "__time_to_str";
+    case T_DATE: return "__date_to_str";
+    case T_TOD: return "__tod_to_str";
+    case T_DT: return "__dt_to_str";
+    default: return "__uint_to_str";
+    }
+}
+
 static void conversion(G *g, Buf *b, Node *n) {
     Type *from = ct(n->conv_from), *to = ct(n->ty);
     Node *a = arg(n, 0);
+    if (from->kind == T_STRING && to->kind == T_STRING) { expr(g, b, a); return; }
+    if (to->kind == T_STRING) { buf_printf(b, "%s(", to_string_fn(from)); expr(g, b, a); buf_put(b, ")"); return; }
+    if (from->kind == T_STRING) {
+        if (to->kind >= T_TIME && to->kind <= T_DT) buf_put(b, "__str_to_time(");
+        else if (to->kind == T_BOOL) buf_put(b, "__str_to_bool(");
+        else if (is_real(to)) buf_printf(b, "((%s)__str_to_real(", cty(n->ty));
+        else buf_printf(b, "((%s)__str_to_int(", cty(n->ty));
+        expr(g, b, a);
+        buf_put(b, to->kind >= T_TIME && to->kind <= T_DT ? ")" : to->kind == T_BOOL ? ")" : "))");
+        return;
+    }
     bool tf = from->kind >= T_TIME && from->kind <= T_DT, tt = to->kind >= T_TIME && to->kind <= T_DT;
     if (tf && tt) {
         const char *f = from->kind == T_DT && to->kind == T_TOD ? "__dt_to_tod" : from->kind == T_DT && to->kind == T_DATE ? "__dt_to_date" : "";
@@ -411,6 +437,26 @@ static void builtin(G *g, Buf *b, Node *n) {
         expr(g, b, arg(n, 1));
         if (n->eno && n->eno->lhs) { buf_put(b, ", &("); expr(g, b, n->eno->lhs); buf_put(b, "))"); }
         else buf_put(b, ", NULL)");
+        return;
+    case B_LIB: {   /* FIND's LINT result cast to the type the context took */
+        bool scalar = t->kind != T_STRING && !(t->kind >= T_TIME && t->kind <= T_DT);
+        if (scalar) buf_printf(b, "((%s)", cty(n->ty));
+        buf_printf(b, "%s(", n->libfn);
+        for (int i = 0; i < n->list.n; i++) {
+            Type *at = ct(arg(n, i)->ty);
+            if (i) buf_put(b, ", ");
+            const char *cast = is_real(at) ? "LREAL" : is_int(at) ? "LINT" : NULL;
+            if (cast) buf_printf(b, "(%s)(", cast);
+            expr(g, b, arg(n, i));
+            if (cast) buf_put(b, ")");
+        }
+        buf_put(b, scalar ? "))" : ")");
+        return;
+    }
+    case B_TO_BCD: case B_FROM_BCD:
+        buf_printf(b, "((%s)%s((ULINT)(", cty(n->ty), id == B_TO_BCD ? "__uint_to_bcd" : "__bcd_to_uint");
+        expr(g, b, arg(n, 0));
+        buf_put(b, ")))");
         return;
     case B_LEN:
         buf_put(b, "((INT)(");
