@@ -382,9 +382,10 @@ static void builtin(G *g, Buf *b, Node *n) {
         call_fn(g, b, fn, n, 1, NULL);
         return;
     case B_SQRT: case B_LN: case B_LOG: case B_EXP: case B_SIN: case B_COS: case B_TAN:
-    case B_ASIN: case B_ACOS: case B_ATAN:
-        snprintf(fn, sizeof fn, "%s%s", math_fn(id), t->kind == T_REAL ? "f" : "");
-        call_fn(g, b, fn, n, 1, NULL);
+    case B_ASIN: case B_ACOS: case B_ATAN:   /* in double, rounded once to REAL (matiec) */
+        if (t->kind == T_REAL) buf_put(b, "((REAL)");
+        call_fn(g, b, math_fn(id), n, 1, NULL);
+        if (t->kind == T_REAL) buf_put(b, ")");
         return;
     case B_EXPT:
         snprintf(fn, sizeof fn, "__EXPT_%s", t->cname);
@@ -411,12 +412,13 @@ static void builtin(G *g, Buf *b, Node *n) {
         snprintf(fn, sizeof fn, "__LIMIT_%s", t->cname);
         call_fn(g, b, fn, n, 3, NULL);
         return;
-    case B_MUX:
+    case B_MUX:   /* matiec's MUX: K out of range gives the initial value, ENO = FALSE */
         buf_printf(b, "__MUX_%s((LINT)(", t->cname);
         expr(g, b, arg(n, 0));
         buf_printf(b, "), %d, (%s[]){", n->list.n - 1, t->cname);
         for (int i = 1; i < n->list.n; i++) { if (i > 1) buf_put(b, ", "); expr(g, b, arg(n, i)); }
-        buf_put(b, "})");
+        if (n->eno && n->eno->lhs) { buf_put(b, "}, &("); expr(g, b, n->eno->lhs); buf_put(b, "))"); }
+        else buf_put(b, "}, NULL)");
         return;
     case B_SHL: case B_SHR: case B_ROL: case B_ROR:
         snprintf(fn, sizeof fn, "__%s_%s", id == B_SHL ? "SHL" : id == B_SHR ? "SHR" : id == B_ROL ? "ROL" : "ROR", t->cname);
@@ -496,7 +498,7 @@ static void builtin_en_eno(G *g, Buf *b, Node *n) {
     bool scalar = t->kind != T_STRING && !(t->kind >= T_TIME && t->kind <= T_DT) && t->kind != T_ARRAY && t->kind != T_STRUCT;
     if (scalar) buf_printf(b, "(%s)", cty(n->ty));
     buf_put(b, "(");
-    if (eno && n->builtin != B_DIV) { buf_put(b, "("); expr(g, b, eno); buf_put(b, ") = 1, "); }
+    if (eno && n->builtin != B_DIV && n->builtin != B_MUX) { buf_put(b, "("); expr(g, b, eno); buf_put(b, ") = 1, "); }
     builtin(g, b, n);
     buf_put(b, ")");
     if (n->en) {

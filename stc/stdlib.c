@@ -50,12 +50,14 @@ const char stdlib_st[] =
 "  Q := CLK AND NOT M;\n"
 "  M := CLK;\n"
 "END_FUNCTION_BLOCK\n"
+/* F_TRIG as IEC 61131-3 (2nd ed., table 35) writes it, and matiec: M holds
+** NOT CLK, FALSE at start, so a first call with CLK = FALSE gives Q = TRUE. */
 "FUNCTION_BLOCK F_TRIG\n"
 "  VAR_INPUT CLK : BOOL; END_VAR\n"
 "  VAR_OUTPUT Q : BOOL; END_VAR\n"
 "  VAR M : BOOL; END_VAR\n"
-"  Q := NOT CLK AND M;\n"
-"  M := CLK;\n"
+"  Q := NOT CLK AND NOT M;\n"
+"  M := NOT CLK;\n"
 "END_FUNCTION_BLOCK\n"
 "FUNCTION_BLOCK SR\n"
 "  VAR_INPUT S1, R : BOOL; END_VAR\n"

@@ -17,7 +17,12 @@ extern BOOL __DEBUG;
 static inline LINT __IDX(LINT v, LINT n) { return v < 0 ? 0 : v >= n ? n - 1 : v; }
 
 /* ---- TIME and dates: {tv_sec, tv_nsec}, tv_nsec in [0, 1e9) ---- */
-static inline LINT __time_ns(IEC_TIME t) { return (LINT)t.tv_sec * 1000000000LL + t.tv_nsec; }
+/* Nanoseconds, saturated at about +-292 years (LINT's range). */
+static inline LINT __time_ns(IEC_TIME t) {
+    if (t.tv_sec > 9223372035L) return INT64_MAX;
+    if (t.tv_sec < -9223372035L) return INT64_MIN;
+    return (LINT)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
 static inline IEC_TIME __time_from_ns(LINT ns) {
     IEC_TIME t;
     t.tv_sec = (long)(ns / 1000000000LL);
@@ -40,7 +45,13 @@ static inline int __time_cmp(IEC_TIME a, IEC_TIME b) {
     if (a.tv_sec != b.tv_sec) return a.tv_sec < b.tv_sec ? -1 : 1;
     return a.tv_nsec < b.tv_nsec ? -1 : a.tv_nsec > b.tv_nsec;
 }
-static inline IEC_TIME __time_mul_int(IEC_TIME a, LINT k) { return __time_from_ns(__time_ns(a) * k); }
+/* TIME times an integer saturates at LINT's nanoseconds (matiec's
+** double arithmetic has no defined result there). */
+static inline IEC_TIME __time_mul_int(IEC_TIME a, LINT k) {
+    LINT ns;
+    if (__builtin_mul_overflow(__time_ns(a), k, &ns)) ns = (__time_ns(a) < 0) != (k < 0) ? INT64_MIN : INT64_MAX;
+    return __time_from_ns(ns);
+}
 static inline IEC_TIME __time_mul_real(IEC_TIME a, LREAL k) { return __time_from_ns((LINT)llround((LREAL)__time_ns(a) * k)); }
 static inline IEC_TIME __time_div_int(IEC_TIME a, LINT k) { return k ? __time_from_ns(__time_ns(a) / k) : (IEC_TIME){0, 0}; }
 static inline IEC_TIME __time_div_real(IEC_TIME a, LREAL k) {
@@ -331,7 +342,9 @@ __IEC_FROM_REAL(WORD, 0, UINT16_MAX)
 __IEC_FROM_REAL(DWORD, 0, UINT32_MAX)
 __IEC_FROM_REAL(LWORD, 0, UINT64_MAX)
 
-static inline REAL __EXPT_REAL(REAL a, LREAL b) { return powf(a, (REAL)b); }
+/* REAL functions are computed in double and rounded once to REAL, as
+** matiec's (sin of a REAL is C's sin of the promoted value). */
+static inline REAL __EXPT_REAL(REAL a, LREAL b) { return (REAL)pow(a, b); }
 static inline LREAL __EXPT_LREAL(LREAL a, LREAL b) { return pow(a, b); }
 
 /* Shifts and rotations of bit strings; shifting by the width or more gives 0. */
@@ -354,8 +367,16 @@ __IEC_SHIFTS(LWORD, 64)
     static inline T __MAX_##T(T a, T b) { return __time_cmp(a, b) > 0 ? a : b; }   \
     static inline T __MIN_##T(T a, T b) { return __time_cmp(a, b) < 0 ? a : b; }   \
     static inline T __LIMIT_##T(T mn, T in, T mx) { return __time_cmp(in, mn) < 0 ? mn : __time_cmp(in, mx) > 0 ? mx : in; }
+/* MUX with K outside 0..n-1 gives the type's initial value and ENO = FALSE
+** (matiec's MUX; the standard calls it an error). */
 #define __IEC_MUX(T)                                                               \
-    static inline T __MUX_##T(LINT k, int n, const T *v) { return v[k >= 0 && k < n ? k : 0]; }
+    static inline T __MUX_##T(LINT k, int n, const T *v, BOOL *eno) {             \
+        if (eno) *eno = k >= 0 && k < n;                                           \
+        if (k >= 0 && k < n) return v[k];                                          \
+        T z;                                                                       \
+        memset(&z, 0, sizeof z);                                                   \
+        return z;                                                                  \
+    }
 __IEC_SELECT(SINT) __IEC_SELECT(INT) __IEC_SELECT(DINT) __IEC_SELECT(LINT)
 __IEC_SELECT(USINT) __IEC_SELECT(UINT) __IEC_SELECT(UDINT) __IEC_SELECT(ULINT)
 __IEC_SELECT(BYTE) __IEC_SELECT(WORD) __IEC_SELECT(DWORD) __IEC_SELECT(LWORD)
