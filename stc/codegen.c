@@ -311,7 +311,6 @@ static const char *to_string_fn(const Type *from) {
 static void conversion(G *g, Buf *b, Node *n) {
     Type *from = ct(n->conv_from), *to = ct(n->ty);
     Node *a = arg(n, 0);
-    if (from->kind == T_STRING && to->kind == T_STRING) { expr(g, b, a); return; }
     if (to->kind == T_STRING) { buf_printf(b, "%s(", to_string_fn(from)); expr(g, b, a); buf_put(b, ")"); return; }
     if (from->kind == T_STRING) {
         if (to->kind >= T_TIME && to->kind <= T_DT) buf_put(b, "__str_to_time(");

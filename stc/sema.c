@@ -1104,7 +1104,8 @@ static const struct LibFn *find_libfn(const char *uname, int *typed) {
 /* The conversions matiec has: CONV_PLAIN <T>_TO_<U> for elementary T, U
    (short names; of the long ones only DATE_AND_TIME_TO_DATE and
    DATE_AND_TIME_TO_TIME_OF_DAY), except between TIME, DATE, TOD and DT
-   where only DT_TO_DATE, DT_TO_TOD and the identities exist; CONV_TO_BCD
+   where only DT_TO_DATE, DT_TO_TOD and the identities exist, and no
+   STRING_TO_STRING; CONV_TO_BCD
    <U>_TO_BCD[_<B>] and CONV_FROM_BCD [<B>_]BCD_TO_<U> for unsigned U and
    bit strings B. A name outside these is free for a user's FUNCTION
    (TIME_TO_TOD, for one). */
@@ -1137,6 +1138,7 @@ static int conv_kind(const char *uname, Type **from, Type **to) {
     *to = short_prim(us + 4, strlen(us + 4));
     if (!*from || !*to) return CONV_NONE;
     int f = (*from)->kind, t = (*to)->kind;
+    if (f == T_STRING && t == T_STRING) return CONV_NONE;
     if (f >= T_TIME && f <= T_DT && t >= T_TIME && t <= T_DT && f != t && !(f == T_DT && (t == T_DATE || t == T_TOD)))
         return CONV_NONE;
     return CONV_PLAIN;
