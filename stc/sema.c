@@ -1359,10 +1359,11 @@ static Type *library_function(Ctx *c, Node *n, const struct LibFn *lf, int typed
         Node **ord = xalloc(sizeof(Node *) * (size_t)lf->nargs);
         for (int i = 0; i < n->list.n; i++) {
             Node *a = n->list.v[i];
+            if (!a->name || a->is_out) { error_at(a->loc, "cannot mix formal (name := value) and positional arguments"); return err_type(); }
             int pos = -1;
-            for (int k = 0; a->name && !a->is_out && k < lf->nargs; k++)
+            for (int k = 0; k < lf->nargs; k++)
                 if (!strcmp(lf->pnames[k], a->uname)) pos = k;
-            if (pos < 0 || ord[pos]) { error_at(a->loc, "unknown parameter '%s' for '%s'", a->name ? a->name : "?", n->name); return err_type(); }
+            if (pos < 0 || ord[pos]) { error_at(a->loc, "unknown parameter '%s' for '%s'", a->name, n->name); return err_type(); }
             ord[pos] = a;
         }
         for (int k = 0; k < lf->nargs; k++)
