@@ -451,13 +451,23 @@ static void builtin(G *g, Buf *b, Node *n) {
             expr(g, b, arg(n, i));
             if (cast) buf_put(b, ")");
         }
+        if (n->libfn[2] >= 'A' && n->libfn[2] <= 'Z') {   /* __LEFT, ...: ENO's address */
+            if (n->eno && n->eno->lhs) { buf_put(b, ", &("); expr(g, b, n->eno->lhs); buf_put(b, ")"); }
+            else buf_put(b, ", NULL");
+        }
         buf_put(b, scalar ? "))" : ")");
         return;
     }
-    case B_TO_BCD: case B_FROM_BCD:
-        buf_printf(b, "((%s)%s((ULINT)(", cty(n->ty), id == B_TO_BCD ? "__uint_to_bcd" : "__bcd_to_uint");
+    case B_TO_BCD:
+        buf_printf(b, "((%s)__uint_to_bcd((ULINT)(", cty(n->ty));
         expr(g, b, arg(n, 0));
         buf_put(b, ")))");
+        return;
+    case B_FROM_BCD:   /* an invalid digit: 0 and ENO = FALSE */
+        buf_printf(b, "((%s)__bcd_to_uint((ULINT)(", cty(n->ty));
+        expr(g, b, arg(n, 0));
+        if (n->eno && n->eno->lhs) { buf_put(b, "), &("); expr(g, b, n->eno->lhs); buf_put(b, ")))"); }
+        else buf_put(b, "), NULL))");
         return;
     case B_LEN:
         buf_put(b, "((INT)(");

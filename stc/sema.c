@@ -1060,7 +1060,9 @@ static const char *const opfns[][2] = {
 /* Standard functions of fixed signature (matiec's time and string
    functions): each input an elementary type, or A_INT (any integer, passed
    as LINT) or A_NUM (any number, passed as LREAL); FIND's result takes the
-   integer type the context wants (INT otherwise). */
+   integer type the context wants (INT otherwise). A helper in upper case
+   takes ENO's address last (NULL when not connected) and clears it when it
+   refuses its inputs. */
 enum { A_INT = -1, A_NUM = -2 };
 static const struct LibFn { const char *name, *cfn; int ret, nargs; const char *pnames[4]; int ptypes[4]; } libfns[] = {
     {"ADD_TIME", "__time_add", T_TIME, 2, {"IN1", "IN2"}, {T_TIME, T_TIME}},
@@ -1075,12 +1077,12 @@ static const struct LibFn { const char *name, *cfn; int ret, nargs; const char *
     {"CONCAT_DATE_TOD", "__time_add", T_DT, 2, {"IN1", "IN2"}, {T_DATE, T_TOD}},
     {"MULTIME", "__time_mul_real", T_TIME, 2, {"IN1", "IN2"}, {T_TIME, A_NUM}},
     {"DIVTIME", "__time_div_real", T_TIME, 2, {"IN1", "IN2"}, {T_TIME, A_NUM}},
-    {"LEFT", "__str_left", T_STRING, 2, {"IN", "L"}, {T_STRING, A_INT}},
-    {"RIGHT", "__str_right", T_STRING, 2, {"IN", "L"}, {T_STRING, A_INT}},
-    {"MID", "__str_mid", T_STRING, 3, {"IN", "L", "P"}, {T_STRING, A_INT, A_INT}},
-    {"INSERT", "__str_insert", T_STRING, 3, {"IN1", "IN2", "P"}, {T_STRING, T_STRING, A_INT}},
-    {"DELETE", "__str_delete", T_STRING, 3, {"IN", "L", "P"}, {T_STRING, A_INT, A_INT}},
-    {"REPLACE", "__str_replace", T_STRING, 4, {"IN1", "IN2", "L", "P"}, {T_STRING, T_STRING, A_INT, A_INT}},
+    {"LEFT", "__LEFT", T_STRING, 2, {"IN", "L"}, {T_STRING, A_INT}},
+    {"RIGHT", "__RIGHT", T_STRING, 2, {"IN", "L"}, {T_STRING, A_INT}},
+    {"MID", "__MID", T_STRING, 3, {"IN", "L", "P"}, {T_STRING, A_INT, A_INT}},
+    {"INSERT", "__INSERT", T_STRING, 3, {"IN1", "IN2", "P"}, {T_STRING, T_STRING, A_INT}},
+    {"DELETE", "__DELETE", T_STRING, 3, {"IN", "L", "P"}, {T_STRING, A_INT, A_INT}},
+    {"REPLACE", "__REPLACE", T_STRING, 4, {"IN1", "IN2", "L", "P"}, {T_STRING, T_STRING, A_INT, A_INT}},
     {"FIND", "__str_find", A_INT, 2, {"IN1", "IN2"}, {T_STRING, T_STRING}},
     {NULL, NULL, 0, 0, {0}, {0}},
 };

@@ -155,6 +155,16 @@ static inline LINT __str_find(STRING in1, STRING in2) {
     return 0;
 }
 
+/* The string functions as called: a negative length or position gives ''
+** and ENO = FALSE (matiec's test); a position of 0 counts as 1. */
+static inline STRING __str_refuse(BOOL *eno) { STRING r = {0, {0}}; if (eno) *eno = 0; return r; }
+static inline STRING __LEFT(STRING in, LINT l, BOOL *eno) { return l < 0 ? __str_refuse(eno) : __str_left(in, l); }
+static inline STRING __RIGHT(STRING in, LINT l, BOOL *eno) { return l < 0 ? __str_refuse(eno) : __str_right(in, l); }
+static inline STRING __MID(STRING in, LINT l, LINT p, BOOL *eno) { return l < 0 || p < 0 ? __str_refuse(eno) : __str_mid(in, l, p); }
+static inline STRING __INSERT(STRING a, STRING b, LINT p, BOOL *eno) { return p < 0 ? __str_refuse(eno) : __str_insert(a, b, p); }
+static inline STRING __DELETE(STRING in, LINT l, LINT p, BOOL *eno) { return l < 0 || p < 0 ? __str_refuse(eno) : __str_delete(in, l, p); }
+static inline STRING __REPLACE(STRING a, STRING b, LINT l, LINT p, BOOL *eno) { return l < 0 || p < 0 ? __str_refuse(eno) : __str_replace(a, b, l, p); }
+
 /* ---- conversions to STRING, in matiec's formats ---- */
 #include <stdio.h>
 #include <stdlib.h>
@@ -268,12 +278,12 @@ static inline IEC_TIME __str_to_time(STRING in) {
 }
 
 /* ---- BCD ---- */
-/* The digits of a BCD bit string, 0 if a nibble is above 9 (matiec sets
-** ENO = FALSE then). */
-static inline ULINT __bcd_to_uint(ULINT in) {
+/* The digits of a BCD bit string; 0 and ENO = FALSE if a nibble is above 9
+** (matiec). */
+static inline ULINT __bcd_to_uint(ULINT in, BOOL *eno) {
     ULINT r = 0, f = 1;
     for (; in; in >>= 4, f *= 10) {
-        if ((in & 15) > 9) return 0;
+        if ((in & 15) > 9) { if (eno) *eno = 0; return 0; }
         r += (in & 15) * f;
     }
     return r;
