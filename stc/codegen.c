@@ -293,9 +293,34 @@ static const char *math_fn(int id) {
 
 static Node *arg(Node *n, int i) { return ((Node *)n->list.v[i])->lhs; }
 
+/* The C helper of <from>_TO_STRING (matiec's formats). */
+static const char *to_string_fn(const Type *from) {
+    switch (from->kind) {
+    case T_BOOL: return "__bool_to_str";
+    case T_BYTE: case T_WORD: case T_DWORD: case T_LWORD: return "__bits_to_str";
+    case T_SINT: case T_INT: case T_DINT: case T_LINT: return "__sint_to_str";
+    case T_REAL: case T_LREAL: return "__real_to_str";
+    case T_TIME: return "__time_to_str";
+    case T_DATE: return "__date_to_str";
+    case T_TOD: return "__tod_to_str";
+    case T_DT: return "__dt_to_str";
+    default: return "__uint_to_str";
+    }
+}
+
 static void conversion(G *g, Buf *b, Node *n) {
     Type *from = ct(n->conv_from), *to = ct(n->ty);
     Node *a = arg(n, 0);
+    if (to->kind == T_STRING) { buf_printf(b, "%s(", to_string_fn(from)); expr(g, b, a); buf_put(b, ")"); return; }
+    if (from->kind == T_STRING) {
+        if (to->kind >= T_TIME && to->kind <= T_DT) buf_put(b, "__str_to_time(");
+        else if (to->kind == T_BOOL) buf_put(b, "__str_to_bool(");
+        else if (is_real(to)) buf_printf(b, "((%s)__str_to_real(", cty(n->ty));
+        else buf_printf(b, "((%s)__str_to_int(", cty(n->ty));
+        expr(g, b, a);
+        buf_put(b, to->kind >= T_TIME && to->kind <= T_DT ? ")" : to->kind == T_BOOL ? ")" : "))");
+        return;
+    }
     bool tf = from->kind >= T_TIME && from->kind <= T_DT, tt = to->kind >= T_TIME && to->kind <= T_DT;
     if (tf && tt) {
         const char *f = from->kind == T_DT && to->kind == T_TOD ? "__dt_to_tod" : from->kind == T_DT && to->kind == T_DATE ? "__dt_to_date" : "";
@@ -356,9 +381,10 @@ static void builtin(G *g, Buf *b, Node *n) {
         call_fn(g, b, fn, n, 1, NULL);
         return;
     case B_SQRT: case B_LN: case B_LOG: case B_EXP: case B_SIN: case B_COS: case B_TAN:
-    case B_ASIN: case B_ACOS: case B_ATAN:
-        snprintf(fn, sizeof fn, "%s%s", math_fn(id), t->kind == T_REAL ? "f" : "");
-        call_fn(g, b, fn, n, 1, NULL);
+    case B_ASIN: case B_ACOS: case B_ATAN:   /* in double, rounded once to REAL (matiec) */
+        if (t->kind == T_REAL) buf_put(b, "((REAL)");
+        call_fn(g, b, math_fn(id), n, 1, NULL);
+        if (t->kind == T_REAL) buf_put(b, ")");
         return;
     case B_EXPT:
         snprintf(fn, sizeof fn, "__EXPT_%s", t->cname);
@@ -385,12 +411,13 @@ static void builtin(G *g, Buf *b, Node *n) {
         snprintf(fn, sizeof fn, "__LIMIT_%s", t->cname);
         call_fn(g, b, fn, n, 3, NULL);
         return;
-    case B_MUX:
+    case B_MUX:   /* matiec's MUX: K out of range gives the initial value, ENO = FALSE */
         buf_printf(b, "__MUX_%s((LINT)(", t->cname);
         expr(g, b, arg(n, 0));
         buf_printf(b, "), %d, (%s[]){", n->list.n - 1, t->cname);
         for (int i = 1; i < n->list.n; i++) { if (i > 1) buf_put(b, ", "); expr(g, b, arg(n, i)); }
-        buf_put(b, "})");
+        if (n->eno && n->eno->lhs) { buf_put(b, "}, &("); expr(g, b, n->eno->lhs); buf_put(b, "))"); }
+        else buf_put(b, "}, NULL)");
         return;
     case B_SHL: case B_SHR: case B_ROL: case B_ROR:
         snprintf(fn, sizeof fn, "__%s_%s", id == B_SHL ? "SHL" : id == B_SHR ? "SHR" : id == B_ROL ? "ROL" : "ROR", t->cname);
@@ -411,6 +438,36 @@ static void builtin(G *g, Buf *b, Node *n) {
         expr(g, b, arg(n, 1));
         if (n->eno && n->eno->lhs) { buf_put(b, ", &("); expr(g, b, n->eno->lhs); buf_put(b, "))"); }
         else buf_put(b, ", NULL)");
+        return;
+    case B_LIB: {   /* FIND's LINT result cast to the type the context took */
+        bool scalar = t->kind != T_STRING && !(t->kind >= T_TIME && t->kind <= T_DT);
+        if (scalar) buf_printf(b, "((%s)", cty(n->ty));
+        buf_printf(b, "%s(", n->libfn);
+        for (int i = 0; i < n->list.n; i++) {
+            Type *at = ct(arg(n, i)->ty);
+            if (i) buf_put(b, ", ");
+            const char *cast = is_real(at) ? "LREAL" : is_int(at) ? "LINT" : NULL;
+            if (cast) buf_printf(b, "(%s)(", cast);
+            expr(g, b, arg(n, i));
+            if (cast) buf_put(b, ")");
+        }
+        if (n->libfn[2] >= 'A' && n->libfn[2] <= 'Z') {   /* __LEFT, ...: ENO's address */
+            if (n->eno && n->eno->lhs) { buf_put(b, ", &("); expr(g, b, n->eno->lhs); buf_put(b, ")"); }
+            else buf_put(b, ", NULL");
+        }
+        buf_put(b, scalar ? "))" : ")");
+        return;
+    }
+    case B_TO_BCD:
+        buf_printf(b, "((%s)__uint_to_bcd((ULINT)(", cty(n->ty));
+        expr(g, b, arg(n, 0));
+        buf_put(b, ")))");
+        return;
+    case B_FROM_BCD:   /* an invalid digit: 0 and ENO = FALSE */
+        buf_printf(b, "((%s)__bcd_to_uint((ULINT)(", cty(n->ty));
+        expr(g, b, arg(n, 0));
+        if (n->eno && n->eno->lhs) { buf_put(b, "), &("); expr(g, b, n->eno->lhs); buf_put(b, ")))"); }
+        else buf_put(b, "), NULL))");
         return;
     case B_LEN:
         buf_put(b, "((INT)(");
@@ -450,7 +507,7 @@ static void builtin_en_eno(G *g, Buf *b, Node *n) {
     bool scalar = t->kind != T_STRING && !(t->kind >= T_TIME && t->kind <= T_DT) && t->kind != T_ARRAY && t->kind != T_STRUCT;
     if (scalar) buf_printf(b, "(%s)", cty(n->ty));
     buf_put(b, "(");
-    if (eno && n->builtin != B_DIV) { buf_put(b, "("); expr(g, b, eno); buf_put(b, ") = 1, "); }
+    if (eno && n->builtin != B_DIV && n->builtin != B_MUX) { buf_put(b, "("); expr(g, b, eno); buf_put(b, ") = 1, "); }
     builtin(g, b, n);
     buf_put(b, ")");
     if (n->en) {

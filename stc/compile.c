@@ -1,4 +1,7 @@
-/* One compilation, from source text to C files; fatal errors return here. */
+/* One compilation, from source text to C files; fatal errors return here.
+** Several input files make one program, as if concatenated in order: each is
+** lexed and parsed on its own (so every diagnostic names the file and line
+** the user wrote), then all declarations are checked together. */
 #include "stc.h"
 
 #include <errno.h>
@@ -6,7 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-int stc_compile(const Source *src, const char *outdir) {
+int stc_compile_files(const Source *srcs, int nsrcs, const char *outdir) {
     static Source lib = {"<standard library>", stdlib_st, 0};
     lib.len = strlen(stdlib_st);
     jmp_buf jb;
@@ -15,11 +18,13 @@ int stc_compile(const Source *src, const char *outdir) {
     if (setjmp(jb)) { stc_error_jmp = NULL; xfree_all(); return 1; }
     Unit u = {0};
     parse_unit(&u, &lib, true);
-    int nlib = u.pous.n;
-    parse_unit(&u, src, false);
-    if (u.pous.n == nlib && !u.types.n && !u.configs.n) {
-        Loc at = {src, 1, 1};
-        fatal_at(at, "nothing to compile: no FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
+    for (int i = 0; i < nsrcs; i++) {
+        int npous = u.pous.n, ntypes = u.types.n, nconfigs = u.configs.n;
+        parse_unit(&u, &srcs[i], false);
+        if (u.pous.n == npous && u.types.n == ntypes && u.configs.n == nconfigs) {
+            Loc at = {&srcs[i], 1, 1};
+            fatal_at(at, "nothing to compile: no FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
+        }
     }
     sema(&u);
     int rc = 1;
@@ -33,4 +38,8 @@ int stc_compile(const Source *src, const char *outdir) {
     stc_error_jmp = NULL;
     xfree_all();
     return rc;
+}
+
+int stc_compile(const Source *src, const char *outdir) {
+    return stc_compile_files(src, 1, outdir);
 }

@@ -24,10 +24,18 @@ static const char *reserved[] = {
     NULL,
 };
 
+static int cmp_word(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
+
+/* Called for every identifier the parser looks at: a binary search in the
+** list, sorted on first use. */
 bool is_reserved(const char *up) {
-    for (const char **r = reserved; *r; r++)
-        if (!strcmp(*r, up)) return true;
-    return false;
+    static const char *sorted[sizeof reserved / sizeof reserved[0]];
+    static size_t n;
+    if (!n) {
+        for (const char **r = reserved; *r; r++) sorted[n++] = *r;
+        qsort(sorted, n, sizeof sorted[0], cmp_word);
+    }
+    return bsearch(&up, sorted, n, sizeof sorted[0], cmp_word) != NULL;
 }
 
 typedef struct {

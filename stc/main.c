@@ -1,4 +1,5 @@
-/* stc command line: stc [-I libdir] [-T outdir] file.st, like matiec's iec2c. */
+/* stc command line: stc [-I libdir] [-T outdir] file.st..., like matiec's iec2c
+** (which takes one file; several make one program, as if concatenated). */
 #include "stc.h"
 
 #include <errno.h>
@@ -11,11 +12,13 @@
 #endif
 
 static void usage(FILE *f) {
-    fputs("usage: stc [-I libdir] [-T outdir] file.st\n"
+    fputs("usage: stc [-I libdir] [-T outdir] file.st...\n"
           "       stc --version | --include-dir | --help\n"
           "Compiles IEC 61131-3 Structured Text to C, in matiec's file layout:\n"
           "POUS.c, POUS.h, <Config>.c/.h, <Resource>.c, LOCATED_VARIABLES.h and\n"
-          "VARIABLES.csv in outdir (default: the current directory).\n"
+          "VARIABLES.csv in outdir (default: the current directory). Several files\n"
+          "make one program, as if concatenated in the order given: what one\n"
+          "declares, the others use.\n"
           "Build the output with: cc -I \"$(stc --include-dir)\" -c <Config>.c <Resource>.c\n"
           "  -I libdir  accepted for iec2c compatibility; the standard library is built in\n"
           "  -T outdir  where to write the C files (created if missing)\n", f);
@@ -44,7 +47,10 @@ static char *read_file(const char *path, size_t *len) {
 }
 
 int main(int argc, char **argv) {
-    const char *outdir = ".", *input = NULL;
+    const char *outdir = ".";
+    int ninputs = 0;
+    Source *inputs = calloc((size_t)argc, sizeof *inputs);
+    if (!inputs) { fputs("stc: out of memory\n", stderr); return 1; }
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--version")) { printf("stc %s\n", STC_VERSION); return 0; }
@@ -59,12 +65,10 @@ int main(int argc, char **argv) {
         if (!strncmp(a, "-T", 2)) { outdir = a + 2; continue; }
         if (!strncmp(a, "-I", 2)) continue;
         if (a[0] == '-' && a[1]) { fprintf(stderr, "stc: unknown option '%s'\n", a); usage(stderr); return 1; }
-        if (input) { fprintf(stderr, "stc: only one input file, got '%s' and '%s'\n", input, a); return 1; }
-        input = a;
+        inputs[ninputs++].name = a;
     }
-    if (!input) { usage(stderr); return 1; }
+    if (!ninputs) { usage(stderr); return 1; }
 
-    Source src = {input, NULL, 0};
-    src.text = read_file(input, &src.len);
-    return stc_compile(&src, outdir);
+    for (int i = 0; i < ninputs; i++) inputs[i].text = read_file(inputs[i].name, &inputs[i].len);
+    return stc_compile_files(inputs, ninputs, outdir);
 }

@@ -876,6 +876,8 @@ static void uses_en_eno(Node *call, Pou *p) {
 
 static void near_builtins(Near *nr);
 
+static Type *prim_named(const char *s, size_t len);
+
 static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
     if (n->lhs) {      /* a[i](...): the instance is an expression */
         Type *it = check(c, n->lhs, NULL);
@@ -920,12 +922,11 @@ static Type *check_call(Ctx *c, Node *n, Type *want, bool stmt) {
     }
     Type *b = check_builtin(c, n, want);
     if (b) return b;
-    const char *unsupported[] = {"LEFT", "RIGHT", "MID", "INSERT", "DELETE", "REPLACE", "FIND", NULL};
-    for (int i = 0; unsupported[i]; i++)
-        if (!strcmp(unsupported[i], n->uname)) {
-            error_at(n->loc, "the standard function %s is not supported by stc", n->uname);
-            return err_type();
-        }
+    const char *us = strstr(n->uname, "_TO_");
+    if (!v && us && prim_named(n->uname, (size_t)(us - n->uname)) && prim_named(us + 4, strlen(us + 4))) {
+        error_at(n->loc, "'%s' is not a standard function (matiec has no such conversion): declare it as a FUNCTION", n->name);
+        return err_type();
+    }
     if (v) { error_at(n->loc, "'%s' is not a function", n->name); return err_type(); }
     Near nr = {n->uname, NULL, 0};
     for (int i = 0; i < c->pous.n; i++)
@@ -1056,8 +1057,98 @@ static const char *const opfns[][2] = {
     {"XOR", "XOR"}, {"NOT", "NOT"}, {"GT", ">"}, {"GE", ">="}, {"EQ", "="}, {"LE", "<="}, {"LT", "<"}, {"NE", "<>"},
 };
 
+/* Standard functions of fixed signature (matiec's time and string
+   functions): each input an elementary type, or A_INT (any integer, passed
+   as LINT) or A_NUM (any number, passed as LREAL); FIND's result takes the
+   integer type the context wants (INT otherwise). A helper in upper case
+   takes ENO's address last (NULL when not connected) and clears it when it
+   refuses its inputs. */
+enum { A_INT = -1, A_NUM = -2 };
+static const struct LibFn { const char *name, *cfn; int ret, nargs; const char *pnames[4]; int ptypes[4]; } libfns[] = {
+    {"ADD_TIME", "__time_add", T_TIME, 2, {"IN1", "IN2"}, {T_TIME, T_TIME}},
+    {"SUB_TIME", "__time_sub", T_TIME, 2, {"IN1", "IN2"}, {T_TIME, T_TIME}},
+    {"ADD_TOD_TIME", "__time_add", T_TOD, 2, {"IN1", "IN2"}, {T_TOD, T_TIME}},
+    {"ADD_DT_TIME", "__time_add", T_DT, 2, {"IN1", "IN2"}, {T_DT, T_TIME}},
+    {"SUB_TOD_TIME", "__time_sub", T_TOD, 2, {"IN1", "IN2"}, {T_TOD, T_TIME}},
+    {"SUB_DT_TIME", "__time_sub", T_DT, 2, {"IN1", "IN2"}, {T_DT, T_TIME}},
+    {"SUB_DATE_DATE", "__time_sub", T_TIME, 2, {"IN1", "IN2"}, {T_DATE, T_DATE}},
+    {"SUB_TOD_TOD", "__time_sub", T_TIME, 2, {"IN1", "IN2"}, {T_TOD, T_TOD}},
+    {"SUB_DT_DT", "__time_sub", T_TIME, 2, {"IN1", "IN2"}, {T_DT, T_DT}},
+    {"CONCAT_DATE_TOD", "__time_add", T_DT, 2, {"IN1", "IN2"}, {T_DATE, T_TOD}},
+    {"MULTIME", "__time_mul_real", T_TIME, 2, {"IN1", "IN2"}, {T_TIME, A_NUM}},
+    {"DIVTIME", "__time_div_real", T_TIME, 2, {"IN1", "IN2"}, {T_TIME, A_NUM}},
+    {"LEFT", "__LEFT", T_STRING, 2, {"IN", "L"}, {T_STRING, A_INT}},
+    {"RIGHT", "__RIGHT", T_STRING, 2, {"IN", "L"}, {T_STRING, A_INT}},
+    {"MID", "__MID", T_STRING, 3, {"IN", "L", "P"}, {T_STRING, A_INT, A_INT}},
+    {"INSERT", "__INSERT", T_STRING, 3, {"IN1", "IN2", "P"}, {T_STRING, T_STRING, A_INT}},
+    {"DELETE", "__DELETE", T_STRING, 3, {"IN", "L", "P"}, {T_STRING, A_INT, A_INT}},
+    {"REPLACE", "__REPLACE", T_STRING, 4, {"IN1", "IN2", "L", "P"}, {T_STRING, T_STRING, A_INT, A_INT}},
+    {"FIND", "__str_find", A_INT, 2, {"IN1", "IN2"}, {T_STRING, T_STRING}},
+    {NULL, NULL, 0, 0, {0}, {0}},
+};
+
+/* MULTIME_<T> and DIVTIME_<T>: the typed forms, IN2 of the number type T. */
+static const char *const numtypes[] = {"SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL", NULL};
+
+static const struct LibFn *find_libfn(const char *uname, int *typed) {
+    *typed = -1;
+    for (int i = 0; libfns[i].name; i++)
+        if (!strcmp(libfns[i].name, uname)) return &libfns[i];
+    for (int k = 0; k < 2; k++) {
+        const char *pre = k ? "DIVTIME_" : "MULTIME_";
+        if (strncmp(uname, pre, 8)) continue;
+        for (int j = 0; numtypes[j]; j++)
+            if (!strcmp(uname + 8, numtypes[j])) { *typed = j; return &libfns[k ? 11 : 10]; }
+    }
+    return NULL;
+}
+
+/* The conversions matiec has: CONV_PLAIN <T>_TO_<U> for elementary T, U
+   (short names; of the long ones only DATE_AND_TIME_TO_DATE and
+   DATE_AND_TIME_TO_TIME_OF_DAY), except between TIME, DATE, TOD and DT
+   where only DT_TO_DATE, DT_TO_TOD and the identities exist, and no
+   STRING_TO_STRING; CONV_TO_BCD
+   <U>_TO_BCD[_<B>] and CONV_FROM_BCD [<B>_]BCD_TO_<U> for unsigned U and
+   bit strings B. A name outside these is free for a user's FUNCTION
+   (TIME_TO_TOD, for one). */
+enum { CONV_NONE, CONV_PLAIN, CONV_TO_BCD, CONV_FROM_BCD };
+static Type *prim_named(const char *s, size_t len);
+static Type *short_prim(const char *s, size_t len) {
+    Type *t = prim_named(s, len);
+    return t && strlen(t->name) == len ? t : NULL;
+}
+static bool is_uint_kind(const Type *t) { return t && (t->kind == T_USINT || t->kind == T_UINT || t->kind == T_UDINT || t->kind == T_ULINT); }
+static bool is_nbit_kind(const Type *t) { return t && (t->kind == T_BYTE || t->kind == T_WORD || t->kind == T_DWORD || t->kind == T_LWORD); }
+static int conv_kind(const char *uname, Type **from, Type **to) {
+    *from = *to = NULL;
+    if (!strcmp(uname, "DATE_AND_TIME_TO_DATE")) { *from = ty_prim[T_DT]; *to = ty_prim[T_DATE]; return CONV_PLAIN; }
+    if (!strcmp(uname, "DATE_AND_TIME_TO_TIME_OF_DAY")) { *from = ty_prim[T_DT]; *to = ty_prim[T_TOD]; return CONV_PLAIN; }
+    const char *bcd = strstr(uname, "BCD_TO_");
+    if (bcd && (bcd == uname || (bcd[-1] == '_' && (*from = short_prim(uname, (size_t)(bcd - 1 - uname))) && is_nbit_kind(*from)))) {
+        *to = short_prim(bcd + 7, strlen(bcd + 7));
+        return is_uint_kind(*to) ? CONV_FROM_BCD : CONV_NONE;
+    }
+    const char *us = strstr(uname, "_TO_BCD");
+    if (us && (!us[7] || us[7] == '_')) {
+        *from = short_prim(uname, (size_t)(us - uname));
+        if (us[7]) { *to = short_prim(us + 8, strlen(us + 8)); if (!is_nbit_kind(*to)) return CONV_NONE; }
+        return is_uint_kind(*from) ? CONV_TO_BCD : CONV_NONE;
+    }
+    us = strstr(uname, "_TO_");
+    if (!us) return CONV_NONE;
+    *from = short_prim(uname, (size_t)(us - uname));
+    *to = short_prim(us + 4, strlen(us + 4));
+    if (!*from || !*to) return CONV_NONE;
+    int f = (*from)->kind, t = (*to)->kind;
+    if (f == T_STRING && t == T_STRING) return CONV_NONE;
+    if (f >= T_TIME && f <= T_DT && t >= T_TIME && t <= T_DT && f != t && !(f == T_DT && (t == T_DATE || t == T_TOD)))
+        return CONV_NONE;
+    return CONV_PLAIN;
+}
+
 static void near_builtins(Near *nr) {
     for (int i = 0; builtins[i].name; i++) near_name(nr, builtins[i].name);
+    for (int i = 0; libfns[i].name; i++) near_name(nr, libfns[i].name);
 }
 
 static const char *opfn_op(const char *uname) {
@@ -1091,7 +1182,7 @@ static bool order_builtin_args(Node *n, int id, int nb) {
         Node *a = n->list.v[i];
         if (!a->name || a->is_out) { error_at(a->loc, "cannot mix formal (name := value) and positional arguments"); return false; }
         int pos = -1;
-        if (id == B_CONV || (nb >= 0 && builtins[nb].nargs == 1)) pos = !strcmp(a->uname, "IN") ? 0 : -1;
+        if (nb < 0 || builtins[nb].nargs == 1) pos = !strcmp(a->uname, "IN") ? 0 : -1;
         else if (nb >= 0 && builtins[nb].nargs > 0) {
             for (int k = 0; k < builtins[nb].nargs; k++)
                 if (builtins[nb].pnames[k] && !strcmp(builtins[nb].pnames[k], a->uname)) pos = k;
@@ -1260,22 +1351,81 @@ static Type *check_builtin(Ctx *c, Node *n, Type *want) {
     return t;
 }
 
-static Type *builtin_value(Ctx *c, Node *n, Type *want) {
-    int id = 0, nb = -1;
-    Type *from = NULL, *to = NULL;
-    const char *us = strstr(n->uname, "_TO_");
-    if (us) {
-        from = prim_named(n->uname, (size_t)(us - n->uname));
-        to = prim_named(us + 4, strlen(us + 4));
-        if (from && to) id = B_CONV;
+/* A call of a library function: its inputs checked against the signature. */
+static Type *library_function(Ctx *c, Node *n, const struct LibFn *lf, int typed, Type *want) {
+    n->builtin = B_LIB;
+    n->libfn = lf->cfn;
+    if (!split_en_eno(n)) return err_type();
+    bool formal = n->list.n && ((Node *)n->list.v[0])->name;
+    if (formal) {
+        Node **ord = xalloc(sizeof(Node *) * (size_t)lf->nargs);
+        for (int i = 0; i < n->list.n; i++) {
+            Node *a = n->list.v[i];
+            if (!a->name || a->is_out) { error_at(a->loc, "cannot mix formal (name := value) and positional arguments"); return err_type(); }
+            int pos = -1;
+            for (int k = 0; k < lf->nargs; k++)
+                if (!strcmp(lf->pnames[k], a->uname)) pos = k;
+            if (pos < 0 || ord[pos]) { error_at(a->loc, "unknown parameter '%s' for '%s'", a->name, n->name); return err_type(); }
+            ord[pos] = a;
+        }
+        for (int k = 0; k < lf->nargs; k++)
+            if (!ord[k]) { error_at(n->loc, "missing parameter '%s' for '%s'", lf->pnames[k], n->name); return err_type(); }
+        n->list.n = 0;
+        for (int k = 0; k < lf->nargs; k++) vec_push(&n->list, ord[k]);
+    } else {
+        for (int i = 0; i < n->list.n; i++)
+            if (((Node *)n->list.v[i])->name) { error_at(((Node *)n->list.v[i])->loc, "cannot mix formal (name := value) and positional arguments"); return err_type(); }
+        if (n->list.n != lf->nargs) {
+            error_at(n->loc, "'%s' expects %d arguments, got %d", n->name, lf->nargs, n->list.n);
+            return err_type();
+        }
     }
+    bool bad = false;
+    for (int k = 0; k < lf->nargs; k++) {
+        Node *a = arg(n, k);
+        int pt = lf->ptypes[k];
+        if (pt == A_NUM && typed >= 0) {
+            Type *tt = NULL;
+            for (int j = 0; j <= T_STRING; j++) if (!strcmp(ty_prim[j]->name, numtypes[typed])) tt = ty_prim[j];
+            check(c, a, tt);
+            check_transfer(tt, a, "type mismatch: parameter '%s' of '%s' expects %4$s, got %3$s", lf->pnames[k], n->name);
+            continue;
+        }
+        if (pt >= 0) {
+            check(c, a, ty_prim[pt]);
+            check_transfer(ty_prim[pt], a, "type mismatch: parameter '%s' of '%s' expects %4$s, got %3$s", lf->pnames[k], n->name);
+            continue;
+        }
+        Type *at = check(c, a, NULL);
+        if (is_err(at)) { bad = true; continue; }
+        if (is_lit(at)) { if (pt == A_INT && at->kind != T_LITINT) goto mismatch; default_lit(a); at = a->ty; }
+        if (pt == A_INT ? is_int(at) : is_num(at)) continue;
+    mismatch:
+        error_at(a->start, "type mismatch: parameter '%s' of '%s' expects %s, got %s", lf->pnames[k], n->name,
+                 pt == A_INT ? "ANY_INT" : "ANY_NUM", type_name(a->ty));
+        bad = true;
+    }
+    if (bad || error_count >= MAX_ERRORS) return err_type();
+    if (lf->ret == A_INT) return want && !is_err(want) && !is_lit(want) && is_int(want) ? want : ty_prim[T_INT];
+    return ty_prim[lf->ret];
+}
+
+static Type *builtin_value(Ctx *c, Node *n, Type *want) {
+    int id = 0, nb = -1, typed;
+    Type *from = NULL, *to = NULL;
+    int ck = conv_kind(n->uname, &from, &to);
+    if (ck == CONV_PLAIN) id = B_CONV;
+    else if (ck == CONV_TO_BCD) id = B_TO_BCD;
+    else if (ck == CONV_FROM_BCD) id = B_FROM_BCD;
+    const struct LibFn *lf = id ? NULL : find_libfn(n->uname, &typed);
+    if (lf) return library_function(c, n, lf, typed, want);
     if (!id)
         for (int i = 0; builtins[i].name; i++)
             if (!strcmp(builtins[i].name, n->uname)) { id = builtins[i].id; nb = i; }
     if (!id) return NULL;
     n->builtin = id;
     if (!split_en_eno(n) || !order_builtin_args(n, id, nb)) return err_type();
-    int want_n = id == B_CONV ? 1 : builtins[nb].nargs;
+    int want_n = nb < 0 ? 1 : builtins[nb].nargs;
     if ((want_n > 0 && n->list.n != want_n) || (want_n < 0 && n->list.n < -want_n)) {
         if (want_n > 0)
             error_at(n->loc, "'%s' expects %d argument%s, got %d", n->name, want_n, want_n == 1 ? "" : "s", n->list.n);
@@ -1285,11 +1435,30 @@ static Type *builtin_value(Ctx *c, Node *n, Type *want) {
     }
     Type *t;
     switch (id) {
-    case B_CONV: {
-        if (from->kind == T_STRING || to->kind == T_STRING) {
-            error_at(n->loc, "'%s': STRING conversions are not supported", n->name);
-            return err_type();
+    case B_TO_BCD: case B_FROM_BCD: {
+        Node *a = arg(n, 0);
+        if (from) {
+            check(c, a, from);
+            check_transfer(from, a, "type mismatch: parameter '%s' of '%s' expects %4$s, got %3$s", "IN", n->name);
+        } else {      /* BCD_TO_<U>: any bit string */
+            Type *at = check(c, a, NULL);
+            if (is_err(at)) return at;
+            if (is_lit(at)) { coerce(a, ty_prim[T_LWORD], true); at = a->ty; }
+            if (!is_nbit_kind(canon(at))) {
+                error_at(a->start, "type mismatch: parameter 'IN' of '%s' expects ANY_BIT, got %s", n->name, type_name(at));
+                return err_type();
+            }
+            from = at;
         }
+        if (!to) {    /* <U>_TO_BCD: the bit string the context wants, else of U's width */
+            Type *cw = want && !is_err(want) ? canon(want) : NULL;
+            if (is_nbit_kind(cw)) to = want;
+            else to = ty_prim[from->kind == T_USINT ? T_BYTE : from->kind == T_UINT ? T_WORD : from->kind == T_UDINT ? T_DWORD : T_LWORD];
+        }
+        n->conv_from = from;
+        return to;
+    }
+    case B_CONV: {
         Node *a = arg(n, 0);
         check(c, a, from);
         check_transfer(from, a, "type mismatch: parameter '%s' of '%s' expects %4$s, got %3$s", "IN", n->name);
@@ -1864,6 +2033,13 @@ static void mark_used(Ctx *c, Pou *p) {
     }
 }
 
+/* " (first declared in FILE:LINE)" when an earlier declaration of a name is
+** in another input file the user wrote, else "". */
+static const char *declared_elsewhere(const Sym *old, Loc here) {
+    if (!old || !old->loc.src || old->loc.src == here.src || old->loc.src->name[0] == '<') return "";
+    return fmt(" (first declared in %s:%d)", old->loc.src->name, old->loc.line);
+}
+
 void sema(Unit *u) {
     for (size_t i = 0; i < sizeof prims / sizeof prims[0]; i++)
         ty_prim[prims[i].k] = new_type(prims[i].k, prims[i].name, prims[i].cname);
@@ -1872,7 +2048,7 @@ void sema(Unit *u) {
     for (int i = 0; i < u->types.n; i++) {
         TypeDecl *d = u->types.v[i];
         if (prim_named(d->uname, strlen(d->uname)) || find(&c.types, d->uname)) {
-            error_at(d->loc, "duplicate declaration of '%s'", d->name);
+            error_at(d->loc, "duplicate declaration of '%s'%s", d->name, declared_elsewhere(find(&c.types, d->uname), d->loc));
             continue;
         }
         Sym *s = new_sym(SK_TYPE, d->name, d->uname, d->loc);
@@ -1882,11 +2058,13 @@ void sema(Unit *u) {
     for (int i = 0; i < u->pous.n; i++) {
         Pou *p = u->pous.v[i];
         if (find(&c.pous, p->uname) || find(&c.types, p->uname) || prim_named(p->uname, strlen(p->uname))) {
-            error_at(p->loc, "duplicate declaration of '%s'", p->name);
+            Sym *old = find(&c.pous, p->uname);
+            error_at(p->loc, "duplicate declaration of '%s'%s", p->name, declared_elsewhere(old ? old : find(&c.types, p->uname), p->loc));
             continue;
         }
-        const char *us = strstr(p->uname, "_TO_");
-        if ((us && prim_named(p->uname, (size_t)(us - p->uname)) && prim_named(us + 4, strlen(us + 4)))) {
+        Type *cf, *cto;
+        int typed;
+        if (conv_kind(p->uname, &cf, &cto) != CONV_NONE || find_libfn(p->uname, &typed)) {
             error_at(p->loc, "duplicate declaration of '%s': it is a standard function", p->name);
             continue;
         }

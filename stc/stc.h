@@ -124,6 +124,7 @@ struct Node {
     int builtin;      /* builtin function id, when > 0 */
     Type *conv_from;  /* builtin conversions and generic functions: operand type */
     Node *en, *eno;   /* standard function calls: EN := input, ENO => target */
+    const char *libfn;  /* B_LIB: the C helper */
     Node *opx;        /* operator functions (ADD, GT, ...): the operator expression they mean */
     bool is_const;    /* constant expression */
     int64_t cval;     /* its integer value when is_const */
@@ -281,6 +282,8 @@ int codegen(Unit *u, const char *outdir);   /* outdir NULL: generate, write noth
 
 /* ---- the whole pipeline (compile.c): 0 on success, 1 after errors ---- */
 int stc_compile(const Source *src, const char *outdir);
+/* Several files, one program: declarations of each are visible in all. */
+int stc_compile_files(const Source *srcs, int nsrcs, const char *outdir);
 
 Type *canon(Type *t);              /* through aliases and subranges */
 
@@ -295,6 +298,9 @@ enum {
     B_OP,       /* ADD, SUB, ..., GT, ..., NOT: Node.opx holds the operator expression */
     B_DIV,      /* DIV: like '/', and ENO is FALSE on a zero divisor */
     B_CONCAT,
+    B_LIB,      /* a function of fixed signature (time, string): Node.libfn is its C helper */
+    B_TO_BCD,   /* <U>_TO_BCD[_<B>] */
+    B_FROM_BCD, /* [<B>_]BCD_TO_<U> */
 };
 
 #endif

@@ -11,16 +11,46 @@
 int error_count;
 jmp_buf *stc_error_jmp;
 
-/* Every allocation of a compilation is chained here and freed at its end. */
+/* Every allocation of a compilation comes from chunks chained here and
+** freed at its end: small ones are carved from 256 KiB chunks (fresh
+** zeroed pages from the system), large ones get a chunk of their own. Under
+** AddressSanitizer every allocation gets its own, so that it can catch an
+** overrun of any of them. */
 typedef struct Chunk { struct Chunk *next; max_align_t data[]; } Chunk;
 static Chunk *chunks;
+static char *arena_at, *arena_end;
+#if defined(__SANITIZE_ADDRESS__)
+#define STC_NO_ARENA 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define STC_NO_ARENA 1
+#endif
+#endif
+#ifdef STC_NO_ARENA
+enum { ARENA = 0 };
+#else
+enum { ARENA = 256 * 1024 };
+#endif
 
-void *xalloc(size_t n) {
-    Chunk *c = calloc(1, sizeof(Chunk) + (n ? n : 1));
+static void *new_chunk(size_t n) {
+    Chunk *c = calloc(1, sizeof(Chunk) + n);
     if (!c) { fputs("stc: out of memory\n", stderr); exit(1); }
     c->next = chunks;
     chunks = c;
     return c->data;
+}
+
+void *xalloc(size_t n) {
+    size_t a = sizeof(max_align_t);
+    n = n ? (n + a - 1) / a * a : a;
+    if (n > ARENA / 8) return new_chunk(n);
+    if ((size_t)(arena_end - arena_at) < n) {
+        arena_at = new_chunk(ARENA);
+        arena_end = arena_at + ARENA;
+    }
+    void *p = arena_at;
+    arena_at += n;
+    return p;
 }
 
 void xfree_all(void) {
@@ -29,6 +59,7 @@ void xfree_all(void) {
         free(chunks);
         chunks = n;
     }
+    arena_at = arena_end = NULL;
 }
 
 char *xstrndup(const char *s, size_t n) {

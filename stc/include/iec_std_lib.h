@@ -17,7 +17,12 @@ extern BOOL __DEBUG;
 static inline LINT __IDX(LINT v, LINT n) { return v < 0 ? 0 : v >= n ? n - 1 : v; }
 
 /* ---- TIME and dates: {tv_sec, tv_nsec}, tv_nsec in [0, 1e9) ---- */
-static inline LINT __time_ns(IEC_TIME t) { return (LINT)t.tv_sec * 1000000000LL + t.tv_nsec; }
+/* Nanoseconds, saturated at about +-292 years (LINT's range). */
+static inline LINT __time_ns(IEC_TIME t) {
+    if (t.tv_sec > 9223372035L) return INT64_MAX;
+    if (t.tv_sec < -9223372035L) return INT64_MIN;
+    return (LINT)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
 static inline IEC_TIME __time_from_ns(LINT ns) {
     IEC_TIME t;
     t.tv_sec = (long)(ns / 1000000000LL);
@@ -40,7 +45,13 @@ static inline int __time_cmp(IEC_TIME a, IEC_TIME b) {
     if (a.tv_sec != b.tv_sec) return a.tv_sec < b.tv_sec ? -1 : 1;
     return a.tv_nsec < b.tv_nsec ? -1 : a.tv_nsec > b.tv_nsec;
 }
-static inline IEC_TIME __time_mul_int(IEC_TIME a, LINT k) { return __time_from_ns(__time_ns(a) * k); }
+/* TIME times an integer saturates at LINT's nanoseconds (matiec's
+** double arithmetic has no defined result there). */
+static inline IEC_TIME __time_mul_int(IEC_TIME a, LINT k) {
+    LINT ns;
+    if (__builtin_mul_overflow(__time_ns(a), k, &ns)) ns = (__time_ns(a) < 0) != (k < 0) ? INT64_MIN : INT64_MAX;
+    return __time_from_ns(ns);
+}
 static inline IEC_TIME __time_mul_real(IEC_TIME a, LREAL k) { return __time_from_ns((LINT)llround((LREAL)__time_ns(a) * k)); }
 static inline IEC_TIME __time_div_int(IEC_TIME a, LINT k) { return k ? __time_from_ns(__time_ns(a) / k) : (IEC_TIME){0, 0}; }
 static inline IEC_TIME __time_div_real(IEC_TIME a, LREAL k) {
@@ -79,6 +90,208 @@ static inline int __str_cmp(STRING a, STRING b) {
     int n = a.len < b.len ? a.len : b.len;
     int c = memcmp(a.body, b.body, (size_t)n);
     return c ? c : (a.len > b.len) - (a.len < b.len);
+}
+
+/* ---- the string functions, with matiec's meaning (positions count from 1;
+** a length or position below 1, or past the end, is clipped instead of
+** reading outside the string) ---- */
+static inline LINT __str_clip(LINT v, LINT hi) { return v < 0 ? 0 : v > hi ? hi : v; }
+static inline STRING __str_left(STRING in, LINT l) {
+    STRING r = {0, {0}};
+    r.len = (uint8_t)__str_clip(l, in.len);
+    memcpy(r.body, in.body, r.len);
+    return r;
+}
+static inline STRING __str_right(STRING in, LINT l) {
+    STRING r = {0, {0}};
+    r.len = (uint8_t)__str_clip(l, in.len);
+    memcpy(r.body, in.body + in.len - r.len, r.len);
+    return r;
+}
+static inline STRING __str_mid(STRING in, LINT l, LINT p) {
+    STRING r = {0, {0}};
+    if (p < 1) p = 1;
+    if (p > in.len) return r;
+    r.len = (uint8_t)__str_clip(l, in.len - (p - 1));
+    memcpy(r.body, in.body + p - 1, r.len);
+    return r;
+}
+/* IN2 inserted after the first P characters of IN1. */
+static inline STRING __str_insert(STRING in1, STRING in2, LINT p) {
+    STRING r = __str_left(in1, p), rest = {0, {0}};
+    rest.len = (uint8_t)(in1.len - r.len);
+    memcpy(rest.body, in1.body + r.len, rest.len);
+    return __str_concat(__str_concat(r, in2), rest);
+}
+/* L characters removed from position P on. */
+static inline STRING __str_delete(STRING in, LINT l, LINT p) {
+    if (p < 1) p = 1;
+    if (p > in.len) return in;
+    STRING r = __str_left(in, p - 1);
+    LINT from = p - 1 + __str_clip(l, in.len);
+    if (from < in.len) { memcpy(r.body + r.len, in.body + from, (size_t)(in.len - from)); r.len = (uint8_t)(r.len + in.len - from); }
+    return r;
+}
+/* L characters from position P on replaced by IN2 (its first L characters). */
+static inline STRING __str_replace(STRING in1, STRING in2, LINT l, LINT p) {
+    if (p < 1) p = 1;
+    l = __str_clip(l, STR_MAX_LEN);
+    STRING r = __str_left(in1, p > in1.len ? in1.len : p - 1);
+    r = __str_concat(r, __str_left(in2, l));
+    LINT from = (p > in1.len ? in1.len : p - 1) + l;
+    if (from < in1.len) {
+        STRING rest = {0, {0}};
+        rest.len = (uint8_t)(in1.len - from);
+        memcpy(rest.body, in1.body + from, rest.len);
+        r = __str_concat(r, rest);
+    }
+    return r;
+}
+/* Position (from 1) of the first IN2 in IN1, 0 when absent or IN2 empty. */
+static inline LINT __str_find(STRING in1, STRING in2) {
+    if (!in2.len || in2.len > in1.len) return 0;
+    for (int i = 0; i + in2.len <= in1.len; i++)
+        if (!memcmp(in1.body + i, in2.body, in2.len)) return i + 1;
+    return 0;
+}
+
+/* The string functions as called: a negative length or position gives ''
+** and ENO = FALSE (matiec's test); a position of 0 counts as 1. */
+static inline STRING __str_refuse(BOOL *eno) { STRING r = {0, {0}}; if (eno) *eno = 0; return r; }
+static inline STRING __LEFT(STRING in, LINT l, BOOL *eno) { return l < 0 ? __str_refuse(eno) : __str_left(in, l); }
+static inline STRING __RIGHT(STRING in, LINT l, BOOL *eno) { return l < 0 ? __str_refuse(eno) : __str_right(in, l); }
+static inline STRING __MID(STRING in, LINT l, LINT p, BOOL *eno) { return l < 0 || p < 0 ? __str_refuse(eno) : __str_mid(in, l, p); }
+static inline STRING __INSERT(STRING a, STRING b, LINT p, BOOL *eno) { return p < 0 ? __str_refuse(eno) : __str_insert(a, b, p); }
+static inline STRING __DELETE(STRING in, LINT l, LINT p, BOOL *eno) { return l < 0 || p < 0 ? __str_refuse(eno) : __str_delete(in, l, p); }
+static inline STRING __REPLACE(STRING a, STRING b, LINT l, LINT p, BOOL *eno) { return l < 0 || p < 0 ? __str_refuse(eno) : __str_replace(a, b, l, p); }
+
+/* ---- conversions to STRING, in matiec's formats ---- */
+#include <stdio.h>
+#include <stdlib.h>
+static inline STRING __str_printed(int n, const char *text) {
+    STRING r = {0, {0}};
+    if (n < 0) n = 0;
+    if (n > STR_MAX_LEN) n = STR_MAX_LEN;
+    memcpy(r.body, text, (size_t)n);
+    r.len = (uint8_t)n;
+    return r;
+}
+static inline STRING __bool_to_str(BOOL in) { return in ? __str_printed(4, "TRUE") : __str_printed(5, "FALSE"); }
+/* bit strings in hexadecimal: WORD 255 is '16#ff' */
+static inline STRING __bits_to_str(ULINT in) { char t[32]; return __str_printed(snprintf(t, sizeof t, "16#%llx", (unsigned long long)in), t); }
+static inline STRING __sint_to_str(LINT in) { char t[32]; return __str_printed(snprintf(t, sizeof t, "%lld", (long long)in), t); }
+static inline STRING __uint_to_str(ULINT in) { char t[32]; return __str_printed(snprintf(t, sizeof t, "%llu", (unsigned long long)in), t); }
+/* REAL and LREAL with ten significant digits, of the value as a double */
+static inline STRING __real_to_str(LREAL in) { char t[64]; return __str_printed(snprintf(t, sizeof t, "%.10g", in), t); }
+/* TIME as T#<d>d<h>h<m>m<s>s<ms>ms, stopping after the last unit that is
+** not zero: T#0d, T#0d2h, T#0d0h0m1s500ms; negative parts keep their sign */
+static inline STRING __time_to_str(IEC_TIME in) {
+    char t[96];
+    LINT ns = __time_ns(in), sec = ns / 1000000000LL, frac = ns % 1000000000LL;
+    LINT d = sec / 86400, h = sec % 86400 / 3600, m = sec % 3600 / 60, s = sec % 60;
+    int n;
+    if (!frac && sec % 86400 == 0) n = snprintf(t, sizeof t, "T#%lldd", (long long)d);
+    else if (!frac && sec % 3600 == 0) n = snprintf(t, sizeof t, "T#%lldd%lldh", (long long)d, (long long)h);
+    else if (!frac && sec % 60 == 0) n = snprintf(t, sizeof t, "T#%lldd%lldh%lldm", (long long)d, (long long)h, (long long)m);
+    else if (!frac) n = snprintf(t, sizeof t, "T#%lldd%lldh%lldm%llds", (long long)d, (long long)h, (long long)m, (long long)s);
+    else n = snprintf(t, sizeof t, "T#%lldd%lldh%lldm%llds%gms", (long long)d, (long long)h, (long long)m, (long long)s, (double)frac / 1e6);
+    return __str_printed(n, t);
+}
+/* Year, month, day of a count of days since 1970-01-01 (proleptic Gregorian). */
+static inline void __civil_date(LINT days, LINT *y, int *mo, int *d) {
+    LINT z = days + 719468, era = (z >= 0 ? z : z - 146096) / 146097;
+    LINT doe = z - era * 146097, yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+    LINT doy = doe - (365 * yoe + yoe / 4 - yoe / 100), mp = (5 * doy + 2) / 153;
+    *d = (int)(doy - (153 * mp + 2) / 5 + 1);
+    *mo = (int)(mp < 10 ? mp + 3 : mp - 9);
+    *y = yoe + era * 400 + (*mo <= 2);
+}
+static inline LINT __floor_div(LINT a, LINT b) { return a / b - (a % b != 0 && (a < 0) != (b < 0)); }
+static inline STRING __date_to_str(IEC_TIME in) {
+    char t[64]; LINT y; int mo, d;
+    __civil_date(__floor_div(in.tv_sec, 86400), &y, &mo, &d);
+    return __str_printed(snprintf(t, sizeof t, "D#%lld-%2.2d-%2.2d", (long long)y, mo, d), t);
+}
+/* hh:mm:ss, or hh:mm:ss.ssssss when there is a fraction of a second */
+static inline int __clock_text(char *t, size_t n, IEC_TIME in) {
+    LINT s = in.tv_sec - __floor_div(in.tv_sec, 86400) * 86400;
+    if (!in.tv_nsec) return snprintf(t, n, "%2.2d:%2.2d:%2.2d", (int)(s / 3600), (int)(s % 3600 / 60), (int)(s % 60));
+    return snprintf(t, n, "%2.2d:%2.2d:%09.6f", (int)(s / 3600), (int)(s % 3600 / 60), (double)(s % 60) + in.tv_nsec / 1e9);
+}
+static inline STRING __tod_to_str(IEC_TIME in) {
+    char t[64], c[40];
+    if (in.tv_sec < 0 || in.tv_sec >= 86400) return __str_printed(9, "TOD#ERROR");
+    __clock_text(c, sizeof c, in);
+    return __str_printed(snprintf(t, sizeof t, "TOD#%s", c), t);
+}
+static inline STRING __dt_to_str(IEC_TIME in) {
+    char t[96], c[40]; LINT y; int mo, d;
+    __civil_date(__floor_div(in.tv_sec, 86400), &y, &mo, &d);
+    __clock_text(c, sizeof c, in);
+    return __str_printed(snprintf(t, sizeof t, "DT#%lld-%2.2d-%2.2d-%s", (long long)y, mo, d, c), t);
+}
+
+/* ---- conversions from STRING, as matiec reads them ---- */
+/* An integer: 2#, 8# or 16# digits (other characters skipped), or decimal:
+** the digits before the first character that is neither a digit nor one of
+** space, sign, comma ('12.7' reads 12, '1_000' reads 1: as matiec), negative
+** when the text starts with '-'. */
+static inline LINT __str_to_int(STRING in) {
+    ULINT r = 0;
+    int base = 0, from = 0;
+    if (in.len > 1 && in.body[0] == '2' && in.body[1] == '#') base = 2, from = 2;
+    else if (in.len > 1 && in.body[0] == '8' && in.body[1] == '#') base = 8, from = 2;
+    else if (in.len > 2 && in.body[0] == '1' && in.body[1] == '6' && in.body[2] == '#') base = 16, from = 3;
+    if (base) {
+        for (int i = from; i < in.len; i++) {
+            int c = in.body[i], v = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : 99;
+            if (v < base) r = r * (ULINT)base + (ULINT)v;
+        }
+        return (LINT)r;
+    }
+    int end = 0;
+    while (end < in.len && ((in.body[end] >= '0' && in.body[end] <= '9') || in.body[end] < '.')) end++;
+    int digits = 0;
+    for (int i = 0; i < end && digits < 19; i++)
+        if (in.body[i] >= '0' && in.body[i] <= '9') { r = r * 10 + (ULINT)(in.body[i] - '0'); digits++; }
+    return in.len && in.body[0] == '-' ? -(LINT)r : (LINT)r;
+}
+static inline BOOL __str_to_bool(STRING in) {
+    if (in.len == 1) return in.body[0] == '1';
+    if (in.len != 4) return 0;
+    for (int i = 0; i < 4; i++) if ((in.body[i] & ~0x20) != "TRUE"[i]) return 0;
+    return 1;
+}
+/* A number with a '.' after its first character reads as a C double,
+** else as an integer. */
+static inline LREAL __str_to_real(STRING in) {
+    if (!memchr(in.body + 1, '.', in.len > 1 ? in.len - 1u : 0u)) return (LREAL)__str_to_int(in);
+    char t[STR_MAX_LEN + 1];
+    memcpy(t, in.body, in.len);
+    t[in.len] = 0;
+    return strtod(t, NULL);
+}
+/* TIME, DATE, TOD, DT from a string count whole seconds, as matiec does. */
+static inline IEC_TIME __str_to_time(STRING in) {
+    LREAL s = __str_to_real(in);
+    return __int_to_time(!(s == s) || s >= 9.2e18 || s <= -9.2e18 ? 0 : (LINT)s);
+}
+
+/* ---- BCD ---- */
+/* The digits of a BCD bit string; 0 and ENO = FALSE if a nibble is above 9
+** (matiec). */
+static inline ULINT __bcd_to_uint(ULINT in, BOOL *eno) {
+    ULINT r = 0, f = 1;
+    for (; in; in >>= 4, f *= 10) {
+        if ((in & 15) > 9) { if (eno) *eno = 0; return 0; }
+        r += (in & 15) * f;
+    }
+    return r;
+}
+static inline ULINT __uint_to_bcd(ULINT in) {
+    ULINT r = 0;
+    for (int sh = 0; in && sh < 64; in /= 10, sh += 4) r |= (in % 10) << sh;
+    return r;
 }
 
 /* ---- per-type helpers ---- */
@@ -139,7 +352,9 @@ __IEC_FROM_REAL(WORD, 0, UINT16_MAX)
 __IEC_FROM_REAL(DWORD, 0, UINT32_MAX)
 __IEC_FROM_REAL(LWORD, 0, UINT64_MAX)
 
-static inline REAL __EXPT_REAL(REAL a, LREAL b) { return powf(a, (REAL)b); }
+/* REAL functions are computed in double and rounded once to REAL, as
+** matiec's (sin of a REAL is C's sin of the promoted value). */
+static inline REAL __EXPT_REAL(REAL a, LREAL b) { return (REAL)pow(a, b); }
 static inline LREAL __EXPT_LREAL(LREAL a, LREAL b) { return pow(a, b); }
 
 /* Shifts and rotations of bit strings; shifting by the width or more gives 0. */
@@ -162,8 +377,16 @@ __IEC_SHIFTS(LWORD, 64)
     static inline T __MAX_##T(T a, T b) { return __time_cmp(a, b) > 0 ? a : b; }   \
     static inline T __MIN_##T(T a, T b) { return __time_cmp(a, b) < 0 ? a : b; }   \
     static inline T __LIMIT_##T(T mn, T in, T mx) { return __time_cmp(in, mn) < 0 ? mn : __time_cmp(in, mx) > 0 ? mx : in; }
+/* MUX with K outside 0..n-1 gives the type's initial value and ENO = FALSE
+** (matiec's MUX; the standard calls it an error). */
 #define __IEC_MUX(T)                                                               \
-    static inline T __MUX_##T(LINT k, int n, const T *v) { return v[k >= 0 && k < n ? k : 0]; }
+    static inline T __MUX_##T(LINT k, int n, const T *v, BOOL *eno) {             \
+        if (eno) *eno = k >= 0 && k < n;                                           \
+        if (k >= 0 && k < n) return v[k];                                          \
+        T z;                                                                       \
+        memset(&z, 0, sizeof z);                                                   \
+        return z;                                                                  \
+    }
 __IEC_SELECT(SINT) __IEC_SELECT(INT) __IEC_SELECT(DINT) __IEC_SELECT(LINT)
 __IEC_SELECT(USINT) __IEC_SELECT(UINT) __IEC_SELECT(UDINT) __IEC_SELECT(ULINT)
 __IEC_SELECT(BYTE) __IEC_SELECT(WORD) __IEC_SELECT(DWORD) __IEC_SELECT(LWORD)

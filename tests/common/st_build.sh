@@ -3,12 +3,14 @@
 # Environment: STC (compiler command), STC_INC (its header folder), CC, CFLAGS.
 common_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 
-# st_compile ST DIR LABEL: stc's output of ST into DIR/c. On failure prints
+# st_compile ST DIR LABEL [MORE.st...]: stc's output of ST (after the files
+# MORE, when given: one program, in that order) into DIR/c. On failure prints
 # "FAIL: LABEL: ..." with the compiler's messages and returns 1.
 st_compile() {
     local st=$1 d=$2 label=$3
+    shift 3
     mkdir -p "$d/c"
-    if ! $STC -T "$d/c" "$st" > "$d/stc.log" 2>&1; then
+    if ! $STC -T "$d/c" "$@" "$st" > "$d/stc.log" 2>&1; then
         echo "FAIL: $label: the compiler rejected it:"
         sed 's/^/    /' "$d/stc.log" | head -20
         return 1

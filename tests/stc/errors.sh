@@ -9,6 +9,9 @@
 # neither may crash stc or take more than 5 s.
 # A file whose first line is (* EXPECT-WARNING line:col message text *) must
 # compile (status 0) with exactly one "warning:" line, at line:col, with the text.
+# A second line "(* FILES a.st b.st *)" (paths from the test's folder) puts
+# those files before the test on stc's command line: one program. The
+# expected spot may then name one of them: EXPECT-ERROR a.st:3:5 text.
 # Then more such inputs, generated into OUTDIR.
 #   tests/stc/errors.sh OUTDIR file.st...
 # Environment: STC (compiler command). Prints PASS:/FAIL: lines.
@@ -19,10 +22,10 @@ status=0
 pass() { echo "PASS: $1"; }
 fail() { echo "FAIL: $1"; shift; for l in "$@"; do printf '    %s\n' "$l"; done; status=1; }
 
-# Run stc on $1; sets rc and log. Status 124 = killed by timeout.
+# Run stc on the files; sets rc and log. Status 124 = killed by timeout.
 compile() {
     rm -rf "$out/c" && mkdir -p "$out/c"
-    log=$(timeout 5 $STC -T "$out/c" "$1" 2>&1 < /dev/null)
+    log=$(timeout 5 $STC -T "$out/c" "$@" 2>&1 < /dev/null)
     rc=$?
 }
 
@@ -61,12 +64,18 @@ for f in "$@"; do
     "(* MUST-FAIL "*) check_robust must_fail "$f" "$f"; continue ;;
     "(* MAY-PASS "*) check_robust may_pass "$f" "$f"; continue ;;
     esac
-    if [[ ! $head =~ ^\(\*\ EXPECT-ERROR\ ([0-9]+):([0-9]+)\ (.*[^ ])\ *\*\)$ ]]; then
+    if [[ ! $head =~ ^\(\*\ EXPECT-ERROR\ ([^ :]+:)?([0-9]+):([0-9]+)\ (.*[^ ])\ *\*\)$ ]]; then
         fail "$f: first line is not (* EXPECT-ERROR line:col message *)"; continue
     fi
-    L=${BASH_REMATCH[1]} C=${BASH_REMATCH[2]} msg=${BASH_REMATCH[3]}
-    name="$f: $L:$C $msg"
-    compile "$f"
+    in=${BASH_REMATCH[1]} L=${BASH_REMATCH[2]} C=${BASH_REMATCH[3]} msg=${BASH_REMATCH[4]}
+    name="$f: $in$L:$C $msg"
+    before=()
+    if [[ $(sed -n 2p "$f") =~ ^\(\*\ FILES\ (.*[^ ])\ *\*\)$ ]]; then
+        for g in ${BASH_REMATCH[1]}; do before+=("$(dirname "$f")/$g"); done
+    fi
+    compile "${before[@]}" "$f"
+    at=$f
+    [ -z "$in" ] || at=$(dirname "$f")/${in%:}
     if [ $rc -ne 1 ]; then
         fail "$name: exit status $rc, expected 1" "$(printf '%s\n' "$log" | head -5)"; continue
     fi
@@ -75,14 +84,14 @@ for f in "$@"; do
         fail "$name: no error line" "$(printf '%s\n' "$log" | head -5)"; continue
     fi
     n=${first%%:*} diag=${first#*:}
-    if [[ $diag != "$f:$L:$C: error: "* ]]; then
+    if [[ $diag != "$at:$L:$C: error: "* ]]; then
         fail "$name: first error is elsewhere" "$diag"; continue
     fi
     if [[ $diag != *"$msg"* ]]; then
         fail "$name: wrong message" "$diag"; continue
     fi
     # The source line must follow, then a caret under column C.
-    src=$(sed -n "${L}p" "$f" | tr -d '\r')
+    src=$(sed -n "${L}p" "$at" | tr -d '\r')
     caret=$(printf '%s\n' "$log" | awk -v n="$n" -v src="$src" -v col="$C" '
         NR <= n { next }
         found { c = substr($0, p + col - 1, 1); print (c == "^" ? "ok" : "caret"); exit }

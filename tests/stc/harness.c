@@ -260,6 +260,7 @@ static int load_script(const char *path)
             if (nticks <= 0) { report(0, "%d: bad TICKS", line); bad = 1; }
             continue;
         }
+        if (!strcmp(tok[0], "FILES") && nt >= 2) continue;   /* run.sh compiles them */
         struct step *s = &steps[nsteps];
         memset(s, 0, sizeof *s);
         s->line = line;

@@ -14,7 +14,13 @@ one() {  # one program; output goes to stdout
     local name; name=$(basename "$st" .st)
     local d="$out/$name"
     rm -rf "$d"
-    st_compile "$st" "$d" "$st" || return
+    # A script line "FILES a.st b.st" (paths from the test's folder): the
+    # program is those files, then this one.
+    local more=() f
+    for f in $(sed -n '1,/\*)/s/^ *FILES //p' "$st" | sed 's/--.*//'); do
+        more+=("$(dirname "$st")/$f")
+    done
+    st_compile "$st" "$d" "$st" "${more[@]}" || return
     st_link "$d" "$here/harness.c" "$d/prog" "$st" || return
     timeout 20 "$d/prog" "$st" > "$d/run.log" 2>&1
     local rc=$?

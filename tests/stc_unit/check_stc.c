@@ -294,6 +294,31 @@ START_TEST(sema_several_errors_reported) {
 }
 END_TEST
 
+/* Several files are one program: a file may use what a later one declares,
+   and a name declared in two files is an error. */
+static int compile_files(const char *a, const char *b) {
+    static Source s[2];
+    s[0] = src_of(a);
+    s[0].name = "a.st";
+    s[1] = src_of(b);
+    s[1].name = "b.st";
+    return stc_compile_files(s, 2, NULL) ? error_count : 0;
+}
+
+START_TEST(sema_files_share_declarations) {
+    ck_assert_int_eq(compile_files(
+        "PROGRAM P VAR m : Mode; i : INT; END_VAR m := Mode#Run; i := Twice(3); END_PROGRAM",
+        "TYPE Mode : (Idle, Run); END_TYPE\n"
+        "FUNCTION Twice : INT VAR_INPUT x : INT; END_VAR Twice := x * 2; END_FUNCTION"), 0);
+    ck_assert_int_eq(compile_files(
+        "FUNCTION Twice : INT VAR_INPUT x : INT; END_VAR Twice := x * 2; END_FUNCTION",
+        "FUNCTION Twice : INT VAR_INPUT x : INT; END_VAR Twice := x; END_FUNCTION"), 1);
+    ck_assert_int_eq(compile_files(
+        "FUNCTION TIME_TO_TOD : TOD VAR_INPUT IN : TIME; END_VAR TIME_TO_TOD := TOD#00:00:00; END_FUNCTION",
+        "PROGRAM P VAR t : TOD; END_VAR t := TIME_TO_TOD(T#1s); END_PROGRAM"), 0);
+}
+END_TEST
+
 static Suite *stc_suite(void) {
     Suite *s = suite_create("stc");
     TCase *lx = tcase_create("lexer");
@@ -323,6 +348,7 @@ static Suite *stc_suite(void) {
     tcase_add_test(sm, sema_literal_takes_context_type);
     tcase_add_test(sm, sema_rules);
     tcase_add_test(sm, sema_several_errors_reported);
+    tcase_add_test(sm, sema_files_share_declarations);
     suite_add_tcase(s, sm);
     return s;
 }
