@@ -23,12 +23,14 @@ limits (POSLIMIT / NEGLIMIT when active, else --travel around the start),
 at VEL --vel and ACC --acc; the motor is switched off and on before each
 run so that a run starts from the axis's position, whatever the previous one
 left.  The gains found are printed and left in the axis (written to its
-parameters); PNG plots of a run before and after tuning are written.
+parameters); each run's capture is kept as aposs-tune-runN.csv, and PNG
+plots of a run before and after tuning are written, all in --out.
 
   tools/aposs_tune.py [--host H] [--port P] [--out DIR] [--dist QC] [--vel %] [--acc %]
 
 Exit status: 0 tuned, 1 a run failed (an error on the axis, no capture)."""
 import argparse
+import csv
 import importlib.machinery
 import importlib.util
 import math
@@ -102,54 +104,42 @@ class Axis:
         self.c.close()
 
 
-def record_move(axis, target, samples, every=1):
-    """Arm the trace on the POSA edge, command the move, return the columns."""
+def record_move(axis, target, samples, csvpath):
+    """A test move recorded by plctrace's own record (in a thread, triggered
+    by the POSA edge): once the trace is armed, command the move; return the
+    columns of the capture by the variables' last names, T in s."""
+    a = argparse.Namespace(host=axis.host, port=axis.port, chan=CHANS, trigger=INST + ".AX.POSA:rise",
+                           pre=20, samples=samples, every=1, timeout=10, output=csvpath, png=None,
+                           no_plot=True, rows=None, title=None)
     out = {}
 
     def rec():
-        p = plctrace.Plc(axis.host, axis.port)
         try:
-            chans = [p.lookup(c) for c in CHANS]
-            tvar = p.lookup(INST + ".AX.POSA")[0]
-            p.command(plctrace.CLAIM, what="claim the trace")
-            try:
-                p.command(plctrace.CHANNELS, [x for c in chans for x in plctrace.args32(c[0])], "channels")
-                p.command(plctrace.SETUP, [every] + plctrace.args32(samples) + plctrace.args32(20)
-                          + [plctrace.TRIGGERS["rise"]] + plctrace.args32(tvar) + [0, 0, 0, 0] + [0], "setup")
-                st0 = p.status()
-                p.command(plctrace.ARM, what="arm")
-                out["armed"] = True
-                end = time.monotonic() + 10
-                while True:
-                    st = p.status()
-                    if st["readable"] and st["seq"] > st0["captures"]:
-                        break
-                    if time.monotonic() > end:
-                        p.command(plctrace.STOP, what="stop")
-                        raise plctrace.Refused("no capture within 10 s")
-                    time.sleep(0.02)
-                out["data"] = plctrace.download(p, st)
-            finally:
-                p.command(plctrace.RELEASE, what="release")
-        except Exception as e:      # reported by the caller
+            plctrace.record(a)
+        except BaseException as e:      # reported by the caller
             out["error"] = e
-        finally:
-            p.close()
 
     th = threading.Thread(target=rec)
     th.start()
-    t0 = time.monotonic()
-    while "armed" not in out and "error" not in out and time.monotonic() - t0 < 5:
-        time.sleep(0.005)
-    time.sleep(0.02)
+    watch = plctrace.Plc(axis.host, axis.port)
+    try:
+        t0 = time.monotonic()
+        while watch.status()["state"] != 1 and th.is_alive() and time.monotonic() - t0 < 5:
+            time.sleep(0.005)
+    finally:
+        watch.close()
+    time.sleep(0.05)    # the trigger is looked for once the pre-trigger samples (20 ms) are in
     axis.set("POS", target)
     axis.pulse("POSA")
     th.join()
     if "error" in out:
         raise SystemExit(f"aposs_tune: trace: {out['error']}")
-    d = out["data"]
-    cols = {name.split(".")[-1].upper(): vals for name, vals in d["cols"]}
-    cols["T"] = [x / 1000.0 for x in d["time_ms"]]
+    with open(csvpath) as f:
+        rows = list(csv.reader(f))
+    cols = {}
+    for k, name in enumerate(rows[0]):
+        cols[name.split(".")[-1].upper()] = [float(r[k]) for r in rows[1:]]
+    cols["T"] = [x / 1000.0 for x in cols["TIME_MS"]]
     return cols
 
 
@@ -157,6 +147,7 @@ class Tuner:
     def __init__(self, axis, a):
         self.ax, self.a = axis, a
         self.runs = 0
+        os.makedirs(a.out, exist_ok=True)
         pl, nl = axis.get("POSLIMIT"), axis.get("NEGLIMIT")
         pa, na = axis.get("SWPOSLIMACT"), axis.get("SWNEGLIMACT")
         p0 = axis.out("APOS")
@@ -179,7 +170,7 @@ class Tuner:
             raise SystemExit(f"aposs_tune: the axis has error {self.ax.out('ERRNUM')}")
         p = self.ax.out("APOS")
         target = self.hi if abs(p - self.lo) < abs(p - self.hi) else self.lo
-        c = record_move(self.ax, target, self.a.samples)
+        c = record_move(self.ax, target, self.a.samples, os.path.join(self.a.out, f"aposs-tune-run{self.runs + 1}.csv"))
         self.runs += 1
         if self.ax.flag("ERROR"):
             raise SystemExit(f"aposs_tune: error {self.ax.out('ERRNUM')} in a test run with {gains}")
@@ -381,7 +372,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--host", default="127.0.0.1")
     ap.add_argument("--port", type=int, default=1502)
-    ap.add_argument("--out", default=".", help="folder of the plots (aposs-tune-before.png, -after.png)")
+    ap.add_argument("--out", default=".", help="folder of the captures and plots (aposs-tune-runN.csv, -before.png, -after.png)")
     ap.add_argument("--dist", type=int, default=50000, help="length of the test move, qc")
     ap.add_argument("--margin", type=int, default=5000, help="distance kept from the software limits, qc")
     ap.add_argument("--vel", type=int, default=100, help="VEL of the test move (1/VELRES of VELMAX)")

@@ -20,6 +20,9 @@ from exlib import Plcrt, free_port, report  # noqa: E402
 def main():
     exe, ini, work = sys.argv[1:4]
     os.makedirs(work, exist_ok=True)
+    for f in os.listdir(work):      # plots of an earlier run must not count
+        if f.startswith("aposs-tune-"):
+            os.remove(os.path.join(work, f))
     port = free_port()
     cfg = exlib.example_ini(ini, os.path.join(work, "tune.ini"), port, "")
     plc = Plcrt(exe, cfg, work, "aposs-tune")
