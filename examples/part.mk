@@ -7,7 +7,8 @@ $(eval $(call plcrt_program,epicpos,$(ST_LIB) examples/epicpos/epicpos.st))
 $(eval $(call plcrt_program,multiaxis,$(ST_LIB) examples/multiaxis/multiaxis.st))
 $(eval $(call plcrt_program,preset,$(ST_LIB) examples/preset/preset.st))
 $(eval $(call plcrt_program,plcopen,$(ST_LIB) examples/plcopen/plcopen.st))
-EXAMPLES := demo epicpos multiaxis preset plcopen
+$(eval $(call plcrt_program,aposs,$(ST_LIB) examples/aposs/aposs.st))
+EXAMPLES := demo epicpos multiaxis preset plcopen aposs
 ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 
 .PHONY: $(EXAMPLES:%=run-%)

@@ -28,6 +28,8 @@ include tests/examples/tests.mk
 
 # ---- apossctl: the APOSS controller part ----
 include tests/apossctl/apossctl.mk
+# ---- apossaxis: the APOSS-style axis device ----
+include tests/apossaxis/apossaxis.mk
 
 # ---- isg: the ISG damping part (seed 004) ----
 include tests/isg/isg.mk
