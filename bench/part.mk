@@ -63,3 +63,12 @@ bench-cam: $(STC) $(ST_LIB)
 	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
 	  bench/cam/bench.sh $(BENCH_B)/cam $(abspath $(ST_LIB))
 BENCHES += bench-cam
+
+# ISGDAMP through EPICPOS: the seed's procedure's figures on the 53 Hz
+# plant (weights, the other sign, move times, the highest stable pgain) and
+# the cost per stage per sample (bench/isg/)
+.PHONY: bench-isg
+bench-isg: $(STC) $(ST_LIB)
+	@env STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" CFLAGS="$(CFLAGS)" \
+	  bench/isg/run.sh $(BENCH_B)/isg $(ST_LIB)
+BENCHES += bench-isg

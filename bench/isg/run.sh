@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# make bench-isg: ISGDAMP through EPICPOS on the simulated plant, the seed's
+# procedure's figures (figures.st, with the TRUN scenario of
+# tests/isg/t_epicpos.st) and the cost per stage per sample (cost.c).
+#   bench/isg/run.sh OUTDIR LIBRARY.st
+# Environment: STC, STC_INC, CC, CFLAGS.
+set -eu
+here=$(cd "$(dirname "$0")" && pwd)
+top=$(cd "$here/../.." && pwd)
+. "$top/tests/common/st_build.sh"
+out=$1 lib=$2
+rm -rf "$out/figures" && mkdir -p "$out/figures"
+d=$out/figures
+{ cat "$lib" "$top/c_blocks/sim_axis.st" "$top/tests/epicpos/tsupport.st"
+  sed -n '/^FUNCTION_BLOCK TRUN/,/^END_FUNCTION_BLOCK/p' "$top/tests/isg/t_epicpos.st"
+  cat "$here/figures.st"; } > "$d/all.st"
+st_compile "$d/all.st" "$d" isg/figures
+st_link "$d" "$here/report.c" "$d/report" isg/figures -I "$top/c_blocks" "$top/c_blocks/plant.c"
+echo "== ISGDAMP through EPICPOS: the seed's procedure on the 53 Hz plant"
+"$d/report" "$here/figures.st" 20000
+"$CC" $CFLAGS -I "$STC_INC" -I "$d/c" -I "$top/c_blocks" -o "$d/isg_cost" \
+    "$here/cost.c" "$top/c_blocks/plant.c" -lm
+echo "== ISGDAMP's cost per sample (DIRECT, order 2; EPICPOS does not call it while isg_enable is FALSE)"
+"$d/isg_cost" 300000 | awk '{ print "  " ($2 == 0 ? "disabled" : $2 " stages") ": " $4 " ns per call"; ns[$2] = $4 }
+    END { printf "  per stage (3 stages - 1 stage) / 2: %.1f ns per sample\n", (ns[3] - ns[1]) / 2 }'
