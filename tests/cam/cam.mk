@@ -4,6 +4,7 @@
 CAM_TESTS := $(wildcard tests/cam/t_*.st)
 
 TESTS += test-cam
+MATIEC_TESTS += test-cam
 
 .PHONY: test-cam
 test-cam: $(ST_LIB) $(STC)
