@@ -808,7 +808,8 @@ static void pou(P *p) {
             (is_kw(peek(p, 1), "VAR") || kw_prefix(peek(p, 1), "VAR_"))) { next(p); continue; }
         if (!var_block(p, &u->vars, false)) break;
     }
-    stmt_list(p, &u->body);
+    if (il_body_starts(p->t, p->n, p->i)) p->i = il_body(p->t, p->n, p->i, u, p->u);
+    else stmt_list(p, &u->body);
     expect_end(p, t, what, end);
     vec_push(&p->u->pous, u);
 }
@@ -924,6 +925,19 @@ static void configuration(P *p) {
     }
     expect_end(p, t, "CONFIGURATION", "END_CONFIGURATION");
     vec_push(&p->u->configs, c);
+}
+
+Node *parse_il_operand(Token *toks, int n, int *i) {
+    P p = {toks, n, *i, 0, NULL, false};
+    Node *e = unary(&p);
+    *i = p.i;
+    return e;
+}
+
+void parse_il_call_args(Token *toks, int n, int *i, Node *call) {
+    P p = {toks, n, *i, 0, NULL, false};
+    call_args(&p, call);
+    *i = p.i;
 }
 
 void parse_unit(Unit *u, const Source *src, bool from_lib) {
