@@ -53,7 +53,8 @@ bool il_body_starts(Token *toks, int n, int i) {
     Token *t = &toks[i], *nx = &toks[i + 1 < n ? i + 1 : n - 1];
     if (t->kind != TK_IDENT) return false;
     if (!strncmp(t->up, "END_", 4)) return false;
-    if (is_p(nx, ":")) return !is_reserved(t->up);          /* a label */
+    if (is_p(nx, ":"))          /* a label, then an instruction (not an ST statement) */
+        return !is_reserved(t->up) && i + 2 < n && il_body_starts(toks, n, i + 2);
     if (!one_of(t->up, il_all_ops)) return false;
     /* ST statements that start with such a name: S := 1; R(...); S.x := ... */
     return !(is_p(nx, ":=") || is_p(nx, ".") || is_p(nx, "[") || is_p(nx, "(") || is_p(nx, "=>"));
@@ -130,11 +131,22 @@ static Node *cr_bool(IL *il, Token *t) {
         vec_push(&il->pou->vars, d);
         il->has_tmp = true;
     }
-    Node *a = node(S_ASSIGN, t);
-    a->lhs = ident_node(t, IL_TMP);
-    a->rhs = v;
-    a->start = v->start;
-    emit(il, a);
+    /* IF cr THEN tmp := TRUE; ELSE tmp := FALSE: a CR that is not BOOL is
+       reported as a condition, at the instruction */
+    v->start = t->loc;
+    Node *n = node(S_IF, t);
+    Vec *body = xalloc(sizeof(Vec));
+    for (int k = 1; k >= 0; k--) {
+        Node *a = node(S_ASSIGN, t);
+        a->lhs = ident_node(t, IL_TMP);
+        a->rhs = node(N_BOOL, t);
+        a->rhs->ival = (uint64_t)k;
+        if (k) vec_push(body, a);
+        else { n->els = node(S_EMPTY, t); vec_push(&n->els->list, a); }
+    }
+    vec_push(&n->list, v);
+    vec_push(&n->list2, body);
+    emit(il, n);
     il->cr = ident_node(t, IL_TMP);
     return ident_node(t, IL_TMP);
 }
@@ -259,6 +271,7 @@ static void instruction(IL *il, int depth) {
         a->lhs = dst;
         a->start = dst->start;
         a->rhs = up[2] ? unary_node(t, "NOT", cr) : cr;
+        a->rhs->start = t->loc;   /* a type mismatch is reported at the ST */
         emit(il, a);
         il->cr = up[2] ? unary_node(t, "NOT", clone(dst)) : clone(dst);
         return;

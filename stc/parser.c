@@ -729,7 +729,7 @@ static Node *statement(P *p) {
     if (is_kw(t, "JMP") || (t->kind == TK_IDENT && !is_reserved(t->up) && is_p(peek(p, 1), ":") && !is_p(peek(p, 2), "=")))
         fatal_at(t->loc, "jumps and labels are not supported by stc");
     if (is_one_of(t, il_ops) && (peek(p, 1)->kind == TK_IDENT || peek(p, 1)->kind == TK_INT || peek(p, 1)->kind == TK_LOCATION))
-        fatal_at(t->loc, "Instruction List (IL) is not supported by stc: it compiles Structured Text");
+        fatal_at(t->loc, "an IL instruction in a Structured Text body: a body is all IL or all ST");
     if (is_kw(t, "EXIT")) { next(p); expect_p(p, ";"); return new_node(S_EXIT, t); }
     if (is_kw(t, "RETURN")) { next(p); expect_p(p, ";"); return new_node(S_RETURN, t); }
     if (t->kind == TK_IDENT && !is_reserved(t->up)) {
