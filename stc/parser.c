@@ -809,6 +809,7 @@ static void pou(P *p) {
         if (!var_block(p, &u->vars, false)) break;
     }
     if (il_body_starts(p->t, p->n, p->i)) p->i = il_body(p->t, p->n, p->i, u, p->u);
+    else if (sfc_body_starts(p->t, p->n, p->i)) p->i = sfc_body(p->t, p->n, p->i, u, p->u);
     else stmt_list(p, &u->body);
     expect_end(p, t, what, end);
     vec_push(&p->u->pous, u);
@@ -937,6 +938,19 @@ Node *parse_il_operand(Token *toks, int n, int *i) {
 void parse_il_call_args(Token *toks, int n, int *i, Node *call) {
     P p = {toks, n, *i, 0, NULL, false};
     call_args(&p, call);
+    *i = p.i;
+}
+
+Node *parse_expr_at(Token *toks, int n, int *i) {
+    P p = {toks, n, *i, 0, NULL, false};
+    Node *e = expr(&p);
+    *i = p.i;
+    return e;
+}
+
+void parse_stmts_at(Token *toks, int n, int *i, Vec *out) {
+    P p = {toks, n, *i, 0, NULL, false};
+    stmt_list(&p, out);
     *i = p.i;
 }
 

@@ -220,10 +220,17 @@ void parse_unit(Unit *u, const Source *src, bool from_lib);
 /* for il.c: one operand (a unary expression), or a call's arguments after '(' */
 Node *parse_il_operand(Token *toks, int n, int *i);
 void parse_il_call_args(Token *toks, int n, int *i, Node *call);
+/* for sfc.c: an expression; statements up to an END_xxx */
+Node *parse_expr_at(Token *toks, int n, int *i);
+void parse_stmts_at(Token *toks, int n, int *i, Vec *out);
 
 /* ---- Instruction List bodies (il.c) ---- */
 bool il_body_starts(Token *toks, int n, int i);
 int il_body(Token *toks, int n, int i, Pou *pou, Unit *u);   /* lowers into pou->body; returns the next token */
+
+/* ---- Sequential Function Chart bodies (sfc.c) ---- */
+bool sfc_body_starts(Token *toks, int n, int i);
+int sfc_body(Token *toks, int n, int i, Pou *pou, Unit *u);  /* lowers into pou->body; returns the next token */
 
 /* ---- semantic types (sema.c) ---- */
 typedef enum {
