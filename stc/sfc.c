@@ -175,6 +175,7 @@ static void action_block(SFC *s) {
 
 /* ---- lowering ---- */
 static Vec glue(const char *text) {
+    if (!text) return (Vec){0};
     Source *src = xalloc(sizeof *src);
     src->name = "<SFC>";
     src->text = text;
@@ -269,11 +270,12 @@ static void lower(SFC *s, Pou *p, Unit *u) {
             if (!find_step(s, f->up)) fatal_at(f->loc, "unknown step '%s'", f->text);
             buf_printf(&g, "%s%s.X", j ? " AND " : "", f->text);
         }
-        buf_printf(&g, " THEN __SFC_TR%d := FALSE; ELSE __SFC_TR%d := FALSE; END_IF;\n", k, k);
+        buf_printf(&g, " THEN IF TRUE THEN __SFC_TR%d := TRUE; ELSE __SFC_TR%d := FALSE; END_IF; ELSE __SFC_TR%d := FALSE; END_IF;\n",
+                   k, k, k);
         Vec v = glue(g.s);
         Node *ifn = v.v[0];
-        Node *asg = ((Vec *)ifn->list2.v[0])->v[0];
-        asg->rhs = tr->cond;
+        Node *inner = ((Vec *)ifn->list2.v[0])->v[0];
+        inner->list.v[0] = tr->cond;   /* a condition that is not BOOL is reported as one */
         vec_push(b, ifn);
     }
     g = (Buf){0};
