@@ -722,7 +722,7 @@ static Node *statement(P *p) {
     }
     if (is_kw(t, "ACTION")) fatal_at(t->loc, "actions (ACTION ... END_ACTION) are not supported by stc");
     if (is_one_of(t, sfc_words))
-        fatal_at(t->loc, "Sequential Function Chart (%s) is not supported by stc", t->up);
+        fatal_at(t->loc, "an SFC element (%s) in a Structured Text body: a body is all SFC or all ST", t->up);
     unsupported_oop(t);
     if (is_kw(t, "CONTINUE") && is_p(peek(p, 1), ";"))
         fatal_at(t->loc, "CONTINUE is not supported by stc (nor by matiec): put the rest of the loop body under an IF");
