@@ -24,9 +24,9 @@
 #include <string.h>
 
 typedef struct { char *uname, *name; Loc loc; bool initial; Vec assoc; } Step;
-typedef struct { char *action; char qual; Loc loc; } Assoc;
+typedef struct { char *action; char qual; Loc loc; Node *time; } Assoc;
 typedef struct { Vec from, to; Node *cond; Loc loc; } Trans;
-typedef struct { char *uname, *name; Loc loc; Vec body; bool block; bool has_nq; } Action;
+typedef struct { char *uname, *name; Loc loc; Vec body; bool block; bool has_sr; } Action;
 
 typedef struct {
     Token *t;
@@ -111,13 +111,19 @@ static void step(SFC *s) {
         if (is_p(cur(s), "(")) {
             s->i++;
             Token *q = name(s, "action qualifier");
-            if (strcmp(q->up, "N") && strcmp(q->up, "S") && strcmp(q->up, "R") && strcmp(q->up, "P"))
-                fatal_at(q->loc, "action qualifier %s is not supported by stc (N, S, R and P are)", q->up);
+            if (strcmp(q->up, "N") && strcmp(q->up, "S") && strcmp(q->up, "R") && strcmp(q->up, "P") &&
+                strcmp(q->up, "L") && strcmp(q->up, "D"))
+                fatal_at(q->loc, "action qualifier %s is not supported by stc (N, S, R, P, L and D are)", q->up);
             as->qual = q->up[0];
+            if (as->qual == 'L' || as->qual == 'D') {
+                if (!is_p(cur(s), ",")) fatal_at(cur(s)->loc, "qualifier %s needs a time: %s(%s, T#1s)", q->up, an->text, q->up);
+                s->i++;
+                as->time = parse_expr_at(s->t, s->n, &s->i);
+            }
             expect_p(s, ")");
         }
         Action *a = action(s, an);
-        if (as->qual == 'N' || as->qual == 'P') a->has_nq = true;
+        if (as->qual == 'S' || as->qual == 'R') a->has_sr = true;
         vec_push(&st->assoc, as);
         expect_p(s, ";");
     }
@@ -295,7 +301,8 @@ static void lower(SFC *s, Pou *p, Unit *u) {
         }
         buf_put(&g, " END_IF;\n");
     }
-    /* associations */
+    /* associations: an ACTION's state, or directly the BOOL variable named */
+    int ntimed = 0;
     for (int k = 0; k < s->steps.n; k++) {
         Step *st = s->steps.v[k];
         const char *x = st->name;
@@ -304,15 +311,41 @@ static void lower(SFC *s, Pou *p, Unit *u) {
             int a = -1;
             for (int m = 0; m < s->actions.n && a < 0; m++)
                 if (!strcmp(((Action *)s->actions.v[m])->uname, as->action)) a = m;
+            Action *ac = s->actions.v[a];
+            const char *q = ac->block ? fmt("__SFC_A%d_Q", a) : ac->name;
+            const char *dt = "";
+            if (as->time) {   /* the time goes through a TIME variable set from the user's expression */
+                dt = fmt("__SFC_DT%d", ntimed++);
+                add_var(p, dt, "TIME", as->loc);
+                Node *asg = xalloc(sizeof *asg);
+                asg->kind = S_ASSIGN;
+                asg->loc = asg->start = as->loc;
+                asg->lhs = xalloc(sizeof *asg->lhs);
+                asg->lhs->kind = N_IDENT;
+                asg->lhs->loc = asg->lhs->start = as->loc;
+                asg->lhs->name = asg->lhs->uname = (char *)dt;
+                asg->rhs = as->time;
+                Vec v = glue(g.s);
+                for (int m = 0; m < v.n; m++) vec_push(b, v.v[m]);
+                g = (Buf){0};
+                vec_push(b, asg);
+            }
             switch (as->qual) {
             case 'N':
-                buf_printf(&g, "IF %s.X THEN __SFC_A%d_Q := TRUE; ELSIF %s.P THEN __SFC_A%d_Q := FALSE; END_IF;\n", x, a, x,
-                           a);
+                buf_printf(&g, "IF %s.X THEN %s := TRUE; ELSIF %s.P THEN %s := FALSE; END_IF;\n", x, q, x, q);
                 break;
             case 'S': buf_printf(&g, "IF %s.X THEN __SFC_A%d_SET := TRUE; END_IF;\n", x, a); break;
             case 'R': buf_printf(&g, "IF %s.X THEN __SFC_A%d_RESET := TRUE; END_IF;\n", x, a); break;
+            case 'L':   /* limited: active for the time given, no longer */
+                buf_printf(&g, "IF %s.X AND %s.T < %s THEN %s := TRUE; ELSIF %s.X OR %s.P THEN %s := FALSE; END_IF;\n", x, x,
+                           dt, q, x, x, q);
+                break;
+            case 'D':   /* delayed: active once the step has lasted the time given */
+                buf_printf(&g, "IF %s.X AND %s.T >= %s THEN %s := TRUE; ELSIF NOT %s.X AND %s.P THEN %s := FALSE; END_IF;\n",
+                           x, x, dt, q, x, x, q);
+                break;
             default:
-                buf_printf(&g, "__SFC_A%d_Q := %s.X AND NOT %s.P;\n", a, x, x);
+                buf_printf(&g, "%s := %s.X AND NOT %s.P;\n", q, x, x);
                 break;
             }
         }
@@ -322,18 +355,15 @@ static void lower(SFC *s, Pou *p, Unit *u) {
                    "IF __SFC_A%d_SET THEN __SFC_A%d_STORED := TRUE; END_IF; IF __SFC_A%d_RESET THEN __SFC_A%d_STORED := FALSE; "
                    "END_IF; __SFC_A%d_Q := __SFC_A%d_Q OR __SFC_A%d_STORED;\n",
                    k, k, k, k, k, k, k);
-    /* associations naming a BOOL variable */
+    /* BOOL variables stored (S) and cleared (R) */
     for (int k = 0; k < s->actions.n; k++) {
         Action *a = s->actions.v[k];
-        if (a->block) continue;
-        if (a->has_nq) buf_printf(&g, "%s := __SFC_A%d_Q;\n", a->name, k);
-        else buf_printf(&g, "IF __SFC_A%d_RESET THEN %s := FALSE; ELSIF __SFC_A%d_SET THEN %s := TRUE; END_IF;\n", k, a->name, k, a->name);
+        if (a->block || !a->has_sr) continue;
+        buf_printf(&g, "IF __SFC_A%d_RESET THEN %s := FALSE; ELSIF __SFC_A%d_SET THEN %s := TRUE; END_IF;\n", k, a->name, k,
+                   a->name);
     }
     Vec v = glue(g.s);
-    for (int k = 0; k < v.n; k++) {
-        /* point the variable actions' diagnostics at the association */
-        vec_push(b, v.v[k]);
-    }
+    for (int k = 0; k < v.n; k++) vec_push(b, v.v[k]);
     for (int k = 0; k < s->actions.n; k++) {
         Action *a = s->actions.v[k];
         if (!a->block) continue;
