@@ -303,6 +303,9 @@ static void instruction(IL *il, int depth) {
         emit(il, if_node(t, c, a));
         return;
     }
+    if ((!strcmp(up, "NOT") || !strncmp(up, "RET", 3)) && same_line(t, cur(il)) && !is_p(cur(il), ";") &&
+        !is_p(cur(il), ")"))
+        fatal_at(cur(il)->loc, "'%s' takes no operand", t->text);
     if (!strcmp(up, "NOT")) {
         il->cr = unary_node(t, "NOT", need_cr(il, t));
         return;
@@ -348,6 +351,7 @@ static void instruction(IL *il, int depth) {
         Node *right;
         if (is_p(cur(il), "(") && same_line(t, cur(il))) {      /* deferred: OP( ... ) */
             Token *open = cur(il);
+            if (depth >= 400) fatal_at(open->loc, "nesting too deep (more than 400 levels)");
             il->i++;
             Node *saved = il->cr;
             Token *savedtok = il->crtok;
@@ -389,6 +393,7 @@ static void instruction(IL *il, int depth) {
             vec_push(&call->list, arg);
             if (!(is_p(cur(il), ",") && same_line(t, cur(il)))) break;
             il->i++;
+            if (!same_line(t, cur(il))) fatal_at(cur(il)->loc, "expected an operand after ','");
         }
     }
     il->cr = call;
