@@ -25,6 +25,7 @@ typedef struct {
     Unit *u;
     Node *cr;          /* current result, NULL when undefined */
     Token *crtok;      /* the instruction that loaded it */
+    const char *why;   /* why the CR is undefined */
     Vec *out;          /* statements of the current level */
     bool has_tmp;
     Vec labels;        /* Node* S_LABEL */
@@ -111,7 +112,9 @@ static Node *binary_node(Token *t, const char *op, Node *l, Node *r) {
 static void emit(IL *il, Node *s) { vec_push(il->out, s); }
 
 static Node *need_cr(IL *il, Token *t) {
-    if (!il->cr) fatal_at(t->loc, "'%s' needs a current result: load one with LD first", t->text);
+    if (!il->cr)
+        fatal_at(t->loc, "'%s' needs a current result: load one with LD first%s%s", t->text, il->why ? "; " : "",
+                 il->why ? il->why : "");
     return clone(il->cr);
 }
 
@@ -226,6 +229,30 @@ static const char *bin_op(const char *up) {
 
 static void instructions(IL *il, int depth, Token *open);
 
+/* does expression e read the variable or instance named up? */
+static bool mentions(Node *e, const char *up) {
+    if (!e) return false;
+    if (e->kind == N_IDENT && !strcmp(e->uname, up)) return true;
+    if (mentions(e->lhs, up) || mentions(e->rhs, up) || mentions(e->third, up) || mentions(e->fourth, up)) return true;
+    for (int k = 0; k < e->list.n; k++)
+        if (mentions(e->list.v[k], up)) return true;
+    return false;
+}
+
+/* the root name of an instance operand: inst, inst.sub, arr[i] */
+static const char *root_name(Node *e) {
+    while (e && e->kind != N_IDENT && !(e->kind == N_CALL && !e->lhs)) e = e->lhs;
+    return e && e->uname ? e->uname : "";
+}
+
+/* after a call of inst, a CR that reads inst is stale: make it undefined */
+static void after_call(IL *il, Node *inst) {
+    if (il->cr && mentions(il->cr, root_name(inst))) {
+        il->cr = NULL;
+        il->why = "the call before may have changed what it read";
+    }
+}
+
 static Node *label_ref(IL *il, Token *op) {
     Token *l = cur(il);
     if (!same_line(op, l) || l->kind != TK_IDENT) fatal_at(op->loc, "'%s' needs a label on the same line", op->text);
@@ -255,9 +282,14 @@ static void instruction(IL *il, int depth) {
         vec_push(&il->labels, l);
         emit(il, l);
         il->cr = NULL;
+        il->why = "a label leaves it undefined";
         return;
     }
     if (t->kind != TK_IDENT) fatal_at(t->loc, "expected an IL instruction, found '%s'", t->text);
+    if (depth && (!strncmp(up, "ST", 2) || !strcmp(up, "S") || !strcmp(up, "R") || !strncmp(up, "CAL", 3) ||
+                  !strcmp(up, "S1") || !strcmp(up, "R1") || !strcmp(up, "CLK") || !strcmp(up, "CU") ||
+                  !strcmp(up, "CD") || !strcmp(up, "PV") || !strcmp(up, "IN") || !strcmp(up, "PT")))
+        fatal_at(t->loc, "'%s' cannot be inside ( ): store or call after the ')'", t->text);
     if (!strcmp(up, "LD") || !strcmp(up, "LDN")) {
         Node *v = operand(il, t);
         il->cr = up[2] ? unary_node(t, "NOT", v) : v;
@@ -281,6 +313,7 @@ static void instruction(IL *il, int depth) {
         Node *cr = need_cr(il, t);
         Node *inst = operand(il, t);
         emit(il, call_stmt(t, fb_call(il, t, inst, up, cr)));
+        after_call(il, inst);
         return;
     }
     if (!strcmp(up, "S") || !strcmp(up, "R")) {
@@ -292,6 +325,7 @@ static void instruction(IL *il, int depth) {
             Node *cr = need_cr(il, t);
             dst = operand(il, t);
             emit(il, call_stmt(t, fb_call(il, t, dst, up, cr)));
+            after_call(il, dst);
             return;
         }
         Node *c = cr_bool(il, t);
@@ -314,7 +348,7 @@ static void instruction(IL *il, int depth) {
         if (depth) fatal_at(t->loc, "a jump cannot be inside ( )");
         Node *c = up[3] ? cr_bool(il, t) : NULL;
         Node *g = label_ref(il, t);
-        if (!c) { emit(il, g); il->cr = NULL; return; }
+        if (!c) { emit(il, g); il->cr = NULL; il->why = "a JMP leaves it undefined"; return; }
         emit(il, if_node(t, up[4] ? unary_node(t, "NOT", c) : c, g));
         return;
     }
@@ -322,7 +356,7 @@ static void instruction(IL *il, int depth) {
         if (depth) fatal_at(t->loc, "RET cannot be inside ( )");
         Node *c = up[3] ? cr_bool(il, t) : NULL;
         Node *r = node(S_RETURN, t);
-        if (!c) { emit(il, r); il->cr = NULL; return; }
+        if (!c) { emit(il, r); il->cr = NULL; il->why = "RET leaves it undefined"; return; }
         emit(il, if_node(t, up[4] ? unary_node(t, "NOT", c) : c, r));
         return;
     }
@@ -333,6 +367,7 @@ static void instruction(IL *il, int depth) {
         if (inst->kind != N_CALL) inst = fb_call(il, t, inst, NULL, NULL);
         Node *s = call_stmt(t, inst);
         emit(il, c ? if_node(t, up[4] ? unary_node(t, "NOT", c) : c, s) : s);
+        after_call(il, inst->kind == N_CALL && inst->lhs ? inst->lhs : inst);
         return;
     }
     /* operators with an optional N and an optional deferred '(' */
