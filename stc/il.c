@@ -26,6 +26,7 @@ typedef struct {
     Node *cr;          /* current result, NULL when undefined */
     Token *crtok;      /* the instruction that loaded it */
     const char *why;   /* why the CR is undefined */
+    bool in_part;      /* an SFC action or transition: no RET */
     Vec *out;          /* statements of the current level */
     bool has_tmp;
     Vec labels;        /* Node* S_LABEL */
@@ -122,6 +123,8 @@ static Node *need_cr(IL *il, Token *t) {
 static Node *cr_bool(IL *il, Token *t) {
     Node *v = need_cr(il, t);
     if (v->kind == N_IDENT && !strcmp(v->uname, IL_TMP)) return v;
+    for (int k = 0; k < il->pou->vars.n && !il->has_tmp; k++)
+        il->has_tmp = !strcmp(((VarDecl *)il->pou->vars.v[k])->uname, IL_TMP);
     if (!il->has_tmp) {
         VarDecl *d = xalloc(sizeof *d);
         d->name = d->uname = IL_TMP;
@@ -354,6 +357,7 @@ static void instruction(IL *il, int depth) {
     }
     if (!strcmp(up, "RET") || !strcmp(up, "RETC") || !strcmp(up, "RETCN")) {
         if (depth) fatal_at(t->loc, "RET cannot be inside ( )");
+        if (il->in_part) fatal_at(t->loc, "RET cannot end an SFC action or transition");
         Node *c = up[3] ? cr_bool(il, t) : NULL;
         Node *r = node(S_RETURN, t);
         if (!c) { emit(il, r); il->cr = NULL; il->why = "RET leaves it undefined"; return; }
@@ -459,8 +463,8 @@ static void instructions(IL *il, int depth, Token *open) {
     if (depth) fatal_at(open->loc, "'(' is never closed by ')'");
 }
 
-int il_body(Token *toks, int n, int i, Pou *pou, Unit *u) {
-    IL il = {.t = toks, .n = n, .i = i, .pou = pou, .u = u, .out = &pou->body};
+int il_lower(Token *toks, int n, int i, Pou *pou, Unit *u, Vec *out, const char *prefix, Node **cr) {
+    IL il = {.t = toks, .n = n, .i = i, .pou = pou, .u = u, .out = out, .in_part = prefix != NULL};
     instructions(&il, 0, NULL);
     for (int k = 0; k < il.gotos.n; k++) {
         Node *g = il.gotos.v[k];
@@ -472,5 +476,20 @@ int il_body(Token *toks, int n, int i, Pou *pou, Unit *u) {
         if (!to) fatal_at(g->loc, "unknown label '%s'", g->name);
         to->ival = 1;   /* jumped to: the C label is emitted */
     }
+    if (prefix) {   /* C labels are per function: those of an action or a transition get its name */
+        for (int k = 0; k < il.gotos.n; k++) {
+            Node *g = il.gotos.v[k];
+            g->uname = fmt("%s_%s", prefix, g->uname);
+        }
+        for (int k = 0; k < il.labels.n; k++) {
+            Node *l = il.labels.v[k];
+            l->uname = fmt("%s_%s", prefix, l->uname);
+        }
+    }
+    if (cr) *cr = need_cr(&il, cur(&il));
     return il.i;
+}
+
+int il_body(Token *toks, int n, int i, Pou *pou, Unit *u) {
+    return il_lower(toks, n, i, pou, u, &pou->body, NULL, NULL);
 }

@@ -25,13 +25,15 @@
 
 typedef struct { char *uname, *name; Loc loc; bool initial; Vec assoc; } Step;
 typedef struct { char *action; char qual; Loc loc; Node *time; } Assoc;
-typedef struct { Vec from, to; Node *cond; Loc loc; } Trans;
+typedef struct { Vec from, to; Node *cond; Vec pre; Loc loc; } Trans;
 typedef struct { char *uname, *name; Loc loc; Vec body; bool block; bool has_sr; } Action;
 
 typedef struct {
     Token *t;
     int n, i;
     Vec steps, trans, actions;
+    Pou *pou;
+    Unit *u;
 } SFC;
 
 static Token *cur(SFC *s) { return &s->t[s->i]; }
@@ -155,11 +157,16 @@ static void transition(SFC *s) {
     step_list(s, &tr->from);
     expect_kw(s, "TO");
     step_list(s, &tr->to);
-    if (!is_p(cur(s), ":="))
-        fatal_at(cur(s)->loc, "expected ':=' and the transition's condition (stc supports the ST form only)");
-    s->i++;
-    tr->cond = parse_expr_at(s->t, s->n, &s->i);
-    expect_p(s, ";");
+    if (is_p(cur(s), ":") && il_body_starts(s->t, s->n, s->i + 1)) {   /* the condition in IL: the last CR */
+        s->i++;
+        s->i = il_lower(s->t, s->n, s->i, s->pou, s->u, &tr->pre, fmt("__TR%d", s->trans.n), &tr->cond);
+    } else {
+        if (!is_p(cur(s), ":="))
+            fatal_at(cur(s)->loc, "expected ':=' and the transition's condition, or ':' and IL");
+        s->i++;
+        tr->cond = parse_expr_at(s->t, s->n, &s->i);
+        expect_p(s, ";");
+    }
     expect_kw(s, "END_TRANSITION");
     if (is_p(cur(s), ";")) s->i++;
     vec_push(&s->trans, tr);
@@ -174,7 +181,8 @@ static void action_block(SFC *s) {
     a->block = true;
     a->loc = nm->loc;
     expect_p(s, ":");
-    parse_stmts_at(s->t, s->n, &s->i, &a->body);
+    if (il_body_starts(s->t, s->n, s->i)) s->i = il_lower(s->t, s->n, s->i, s->pou, s->u, &a->body, fmt("__A_%s", a->uname), NULL);
+    else parse_stmts_at(s->t, s->n, &s->i, &a->body);
     expect_kw(s, "END_ACTION");
     if (is_p(cur(s), ";")) s->i++;
 }
@@ -280,8 +288,15 @@ static void lower(SFC *s, Pou *p, Unit *u) {
                    k, k, k);
         Vec v = glue(g.s);
         Node *ifn = v.v[0];
-        Node *inner = ((Vec *)ifn->list2.v[0])->v[0];
+        Vec *then = ifn->list2.v[0];
+        Node *inner = then->v[0];
         inner->list.v[0] = tr->cond;   /* a condition that is not BOOL is reported as one */
+        if (tr->pre.n) {               /* the IL before the condition, in the same branch */
+            Vec all = {0};
+            for (int j = 0; j < tr->pre.n; j++) vec_push(&all, tr->pre.v[j]);
+            vec_push(&all, inner);
+            *then = all;
+        }
         vec_push(b, ifn);
     }
     g = (Buf){0};
@@ -376,7 +391,7 @@ static void lower(SFC *s, Pou *p, Unit *u) {
 }
 
 int sfc_body(Token *toks, int n, int i, Pou *pou, Unit *u) {
-    SFC s = {.t = toks, .n = n, .i = i};
+    SFC s = {.t = toks, .n = n, .i = i, .pou = pou, .u = u};
     if (pou->kind == POU_FUNCTION) fatal_at(toks[i].loc, "a FUNCTION cannot be written in SFC (it keeps no state)");
     for (;;) {
         Token *t = cur(&s);

@@ -227,6 +227,8 @@ void parse_stmts_at(Token *toks, int n, int *i, Vec *out);
 /* ---- Instruction List bodies (il.c) ---- */
 bool il_body_starts(Token *toks, int n, int i);
 int il_body(Token *toks, int n, int i, Pou *pou, Unit *u);   /* lowers into pou->body; returns the next token */
+/* an SFC action (into out) or transition (*cr: the condition); labels get prefix */
+int il_lower(Token *toks, int n, int i, Pou *pou, Unit *u, Vec *out, const char *prefix, Node **cr);
 
 /* ---- Sequential Function Chart bodies (sfc.c) ---- */
 bool sfc_body_starts(Token *toks, int n, int i);
