@@ -861,6 +861,13 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         indent(b, ind);
         buf_put(b, "break;\n");
         return;
+    case S_LABEL:   /* IL */
+        if (s->ival) buf_printf(b, "__il_%s:;\n", s->uname);
+        return;
+    case S_GOTO:
+        indent(b, ind);
+        buf_printf(b, "goto __il_%s;\n", s->uname);
+        return;
     case S_RETURN:
         indent(b, ind);
         buf_put(b, g->pou && g->pou->kind == POU_FUNCTION ? "return __res;\n" : "return;\n");

@@ -722,14 +722,14 @@ static Node *statement(P *p) {
     }
     if (is_kw(t, "ACTION")) fatal_at(t->loc, "actions (ACTION ... END_ACTION) are not supported by stc");
     if (is_one_of(t, sfc_words))
-        fatal_at(t->loc, "Sequential Function Chart (%s) is not supported by stc", t->up);
+        fatal_at(t->loc, "an SFC element (%s) in a Structured Text body: a body is all SFC or all ST", t->up);
     unsupported_oop(t);
     if (is_kw(t, "CONTINUE") && is_p(peek(p, 1), ";"))
         fatal_at(t->loc, "CONTINUE is not supported by stc (nor by matiec): put the rest of the loop body under an IF");
     if (is_kw(t, "JMP") || (t->kind == TK_IDENT && !is_reserved(t->up) && is_p(peek(p, 1), ":") && !is_p(peek(p, 2), "=")))
         fatal_at(t->loc, "jumps and labels are not supported by stc");
     if (is_one_of(t, il_ops) && (peek(p, 1)->kind == TK_IDENT || peek(p, 1)->kind == TK_INT || peek(p, 1)->kind == TK_LOCATION))
-        fatal_at(t->loc, "Instruction List (IL) is not supported by stc: it compiles Structured Text");
+        fatal_at(t->loc, "an IL instruction in a Structured Text body: a body is all IL or all ST");
     if (is_kw(t, "EXIT")) { next(p); expect_p(p, ";"); return new_node(S_EXIT, t); }
     if (is_kw(t, "RETURN")) { next(p); expect_p(p, ";"); return new_node(S_RETURN, t); }
     if (t->kind == TK_IDENT && !is_reserved(t->up)) {
@@ -808,7 +808,9 @@ static void pou(P *p) {
             (is_kw(peek(p, 1), "VAR") || kw_prefix(peek(p, 1), "VAR_"))) { next(p); continue; }
         if (!var_block(p, &u->vars, false)) break;
     }
-    stmt_list(p, &u->body);
+    if (il_body_starts(p->t, p->n, p->i)) p->i = il_body(p->t, p->n, p->i, u, p->u);
+    else if (sfc_body_starts(p->t, p->n, p->i)) p->i = sfc_body(p->t, p->n, p->i, u, p->u);
+    else stmt_list(p, &u->body);
     expect_end(p, t, what, end);
     vec_push(&p->u->pous, u);
 }
@@ -924,6 +926,32 @@ static void configuration(P *p) {
     }
     expect_end(p, t, "CONFIGURATION", "END_CONFIGURATION");
     vec_push(&p->u->configs, c);
+}
+
+Node *parse_il_operand(Token *toks, int n, int *i) {
+    P p = {toks, n, *i, 0, NULL, false};
+    Node *e = unary(&p);
+    *i = p.i;
+    return e;
+}
+
+void parse_il_call_args(Token *toks, int n, int *i, Node *call) {
+    P p = {toks, n, *i, 0, NULL, false};
+    call_args(&p, call);
+    *i = p.i;
+}
+
+Node *parse_expr_at(Token *toks, int n, int *i) {
+    P p = {toks, n, *i, 0, NULL, false};
+    Node *e = expr(&p);
+    *i = p.i;
+    return e;
+}
+
+void parse_stmts_at(Token *toks, int n, int *i, Vec *out) {
+    P p = {toks, n, *i, 0, NULL, false};
+    stmt_list(&p, out);
+    *i = p.i;
 }
 
 void parse_unit(Unit *u, const Source *src, bool from_lib) {

@@ -96,6 +96,8 @@ typedef enum {
     S_PRAGMA, S_EMPTY,
     S_CASEITEM,   /* labels (list of N_RANGE or exprs) + body */
     N_RANGE,      /* lo..hi */
+    S_LABEL,      /* IL label: name; ival 1 when a jump goes there */
+    S_GOTO,       /* IL jump to the label name */
 } NodeKind;
 
 struct Node {
@@ -216,6 +218,22 @@ typedef struct Unit {
 } Unit;
 
 void parse_unit(Unit *u, const Source *src, bool from_lib);
+/* for il.c: one operand (a unary expression), or a call's arguments after '(' */
+Node *parse_il_operand(Token *toks, int n, int *i);
+void parse_il_call_args(Token *toks, int n, int *i, Node *call);
+/* for sfc.c: an expression; statements up to an END_xxx */
+Node *parse_expr_at(Token *toks, int n, int *i);
+void parse_stmts_at(Token *toks, int n, int *i, Vec *out);
+
+/* ---- Instruction List bodies (il.c) ---- */
+bool il_body_starts(Token *toks, int n, int i);
+int il_body(Token *toks, int n, int i, Pou *pou, Unit *u);   /* lowers into pou->body; returns the next token */
+/* an SFC action (into out) or transition (*cr: the condition); labels get prefix */
+int il_lower(Token *toks, int n, int i, Pou *pou, Unit *u, Vec *out, const char *prefix, Node **cr);
+
+/* ---- Sequential Function Chart bodies (sfc.c) ---- */
+bool sfc_body_starts(Token *toks, int n, int i);
+int sfc_body(Token *toks, int n, int i, Pou *pou, Unit *u);  /* lowers into pou->body; returns the next token */
 
 /* ---- semantic types (sema.c) ---- */
 typedef enum {

@@ -144,6 +144,15 @@ check_robust may_pass "IF nested 20000 deep" "$g/deep-if.st"
 { printf '%s' "$prologue"; rep 'IF TRUE THEN ' 20000; printf '\nEND_PROGRAM\n'; } > "$g/open-if.st"
 check_robust must_fail "20000 unclosed IF" "$g/open-if.st"
 
+{ printf '%sLD x\n' "$prologue"; rep 'ADD( x\n' 100000; rep ')\n' 100000; printf 'ST x\nEND_PROGRAM\n'; } > "$g/il-deep-parens.st"
+check_robust must_fail "IL deferred operations 100000 deep" "$g/il-deep-parens.st"
+
+{ printf '%sLD x\n' "$prologue"; rep 'ADD x\n' 100000; printf 'ST x\nEND_PROGRAM\n'; } > "$g/il-long.st"
+check_robust may_pass "IL sequence of 100000 operators" "$g/il-long.st"
+
+{ printf '%s' "$prologue"; printf 'INITIAL_STEP s0:\nEND_STEP\n'; for ((i = 1; i < 2000; i++)); do printf 'STEP s%d:\nEND_STEP\nTRANSITION FROM s%d TO s%d\n := TRUE;\nEND_TRANSITION\n' $i $((i - 1)) $i; done; printf 'END_PROGRAM\n'; } > "$g/sfc-long.st"
+check_robust may_pass "SFC chain of 2000 steps" "$g/sfc-long.st"
+
 { printf '%sx := 1' "$prologue"; rep '0' 100000; printf ';\nEND_PROGRAM\n'; } > "$g/huge-literal.st"
 check_robust must_fail "integer literal of 100001 digits" "$g/huge-literal.st"
 
