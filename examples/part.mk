@@ -7,7 +7,10 @@ $(eval $(call plcrt_program,epicpos,$(ST_LIB) examples/epicpos/epicpos.st))
 $(eval $(call plcrt_program,multiaxis,$(ST_LIB) examples/multiaxis/multiaxis.st))
 $(eval $(call plcrt_program,preset,$(ST_LIB) examples/preset/preset.st))
 $(eval $(call plcrt_program,plcopen,$(ST_LIB) examples/plcopen/plcopen.st))
-EXAMPLES := demo epicpos multiaxis preset plcopen
+CAM_COMMON := $(ST_LIB) examples/cam_common/camaxis.st
+$(eval $(call plcrt_program,cam_stamping,$(CAM_COMMON) examples/cam_stamping/cam_stamping.st))
+CAM_EXAMPLES := cam_stamping
+EXAMPLES := demo epicpos multiaxis preset plcopen $(CAM_EXAMPLES)
 ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 
 .PHONY: $(EXAMPLES:%=run-%)
