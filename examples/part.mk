@@ -9,7 +9,8 @@ $(eval $(call plcrt_program,preset,$(ST_LIB) examples/preset/preset.st))
 $(eval $(call plcrt_program,plcopen,$(ST_LIB) examples/plcopen/plcopen.st))
 CAM_COMMON := $(ST_LIB) examples/cam_common/camaxis.st
 $(eval $(call plcrt_program,cam_stamping,$(CAM_COMMON) examples/cam_stamping/cam_stamping.st))
-CAM_EXAMPLES := cam_stamping
+$(eval $(call plcrt_program,cam_dryer,$(ST_LIB) examples/cam_dryer/cam_dryer.st))
+CAM_EXAMPLES := cam_stamping cam_dryer
 EXAMPLES := demo epicpos multiaxis preset plcopen $(CAM_EXAMPLES)
 ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 
