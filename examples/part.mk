@@ -11,7 +11,8 @@ CAM_COMMON := $(ST_LIB) examples/cam_common/camaxis.st
 $(eval $(call plcrt_program,cam_stamping,$(CAM_COMMON) examples/cam_stamping/cam_stamping.st))
 $(eval $(call plcrt_program,cam_dryer,$(ST_LIB) examples/cam_dryer/cam_dryer.st))
 $(eval $(call plcrt_program,cam_printing,$(CAM_COMMON) examples/cam_printing/cam_printing.st))
-CAM_EXAMPLES := cam_stamping cam_dryer cam_printing
+$(eval $(call plcrt_program,cam_slavesync,$(CAM_COMMON) examples/cam_slavesync/cam_slavesync.st))
+CAM_EXAMPLES := cam_stamping cam_dryer cam_printing cam_slavesync
 EXAMPLES := demo epicpos multiaxis preset plcopen $(CAM_EXAMPLES)
 ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 

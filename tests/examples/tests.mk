@@ -3,7 +3,7 @@
 # configuration with a port free at run time and a private retain file.
 EX_T := $(BUILD)/tests/examples
 # the CAM examples (examples/cam_*; this file is read before examples/part.mk)
-EX_CAM := cam_stamping cam_dryer cam_printing
+EX_CAM := cam_stamping cam_dryer cam_printing cam_slavesync
 EX_RUN = mk/suite.sh $(RESULTS) examples-$(1) python3 tests/examples/test_$(1).py \
 	  $(BUILD)/plc/$(1)/plcrt examples/$(1)/$(1).ini $(abspath $(EX_T))/$(1)
 
