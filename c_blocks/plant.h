@@ -107,7 +107,8 @@ int32_t plant_master_counter(const plant_master *m);
 ** uniformly in [-noise, +noise] (a deterministic generator from `seed`).
 ** The count there is latched, as the encoder latches the zero pulse, so
 ** the marker's position is exact in the latch even when the pulse is seen
-** a cycle late. Markers passed backwards are not seen. */
+** a cycle late. Markers passed backwards are not seen, and each marker
+** pulses once (a product passing the sensor again is not counted again). */
 typedef struct plant_marker_params {
     double first, pitch, noise;   /* counts */
     uint32_t seed;
