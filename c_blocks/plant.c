@@ -228,6 +228,68 @@ int plant_cam(const plant *s)
     return s->p.cam_low <= s->p.cam_high && s->xl >= s->p.cam_low && s->xl <= s->p.cam_high;
 }
 
+void plant_master_init(plant_master *m, const plant_master_params *p)
+{
+    m->p = *p;
+    m->t = 0;
+    m->x = p->start;
+}
+
+void plant_master_step(plant_master *m, double dt)
+{
+    const double pi = 3.14159265358979323846;
+    const plant_master_params *p = &m->p;
+    m->t += dt;
+    m->x = p->start + p->speed * m->t;
+    if (p->speed_hz > 0)
+        m->x += p->speed_amp / (2 * pi * p->speed_hz) * (1 - cos(2 * pi * p->speed_hz * m->t));
+}
+
+int32_t plant_master_counter(const plant_master *m)
+{
+    return (int32_t)(uint32_t)(int64_t)floor(m->x);
+}
+
+/* uniform in [-1, 1], xorshift64* */
+static double marker_noise(plant_marker *m)
+{
+    m->rng ^= m->rng >> 12; m->rng ^= m->rng << 25; m->rng ^= m->rng >> 27;
+    uint64_t r = m->rng * 2685821657736338717ULL;
+    return (double)(r >> 11) / (double)(1ULL << 53) * 2 - 1;
+}
+
+static void marker_place(plant_marker *m)
+{
+    m->next = m->p.first + (double)m->k * m->p.pitch + m->p.noise * marker_noise(m);
+}
+
+void plant_marker_init(plant_marker *m, const plant_marker_params *p)
+{
+    memset(m, 0, sizeof *m);
+    m->p = *p;
+    m->rng = 0x9E3779B97F4A7C15ULL ^ p->seed;
+    if (!m->rng) m->rng = 1;
+    marker_place(m);
+}
+
+void plant_marker_step(plant_marker *m, double x0, double x1)
+{
+    m->on = 0;
+    if (m->p.pitch <= 0) return;
+    if (m->k == 0 && x0 > m->next + m->p.noise) {
+        /* started beyond the first markers: the next one ahead */
+        m->k = (uint32_t)ceil((x0 - m->p.first) / m->p.pitch);
+        marker_place(m);
+    }
+    while (x1 > x0 && x0 < m->next && m->next <= x1) {
+        m->latch = (int32_t)(uint32_t)(int64_t)floor(m->next);
+        m->count++;
+        m->on = 1;
+        m->k++;
+        marker_place(m);
+    }
+}
+
 void plant_step_array(double *v, int16_t dac, double dt)
 {
     plant s;

@@ -86,6 +86,46 @@ int32_t plant_motor_counter(const plant *s);     /* motor encoder */
 int plant_has_modes(const plant_params *p);
 int plant_cam(const plant *s);
 
+/* Master axis: a position that runs by itself, with no drive (a line shaft,
+** a conveyor at its own speed): x(t) = start + speed t
+** + speed_amp / (2 pi speed_hz) (1 - cos(2 pi speed_hz t)), i.e. the speed
+** speed + speed_amp sin(2 pi speed_hz t) counts/s (speed_hz 0: constant).
+** Computed from t in closed form, so no error accumulates. */
+typedef struct plant_master_params {
+    double speed, speed_amp, speed_hz, start;
+} plant_master_params;
+typedef struct plant_master {
+    plant_master_params p;
+    double t, x;
+} plant_master;
+void plant_master_init(plant_master *m, const plant_master_params *p);
+void plant_master_step(plant_master *m, double dt);
+int32_t plant_master_counter(const plant_master *m);
+
+/* Marker sensor: a digital input that pulses once per product (cycle) as
+** the position it watches passes first + k pitch + e_k forwards, e_k drawn
+** uniformly in [-noise, +noise] (a deterministic generator from `seed`).
+** The count there is latched, as the encoder latches the zero pulse, so
+** the marker's position is exact in the latch even when the pulse is seen
+** a cycle late. Markers passed backwards are not seen, and each marker
+** pulses once (a product passing the sensor again is not counted again). */
+typedef struct plant_marker_params {
+    double first, pitch, noise;   /* counts */
+    uint32_t seed;
+} plant_marker_params;
+typedef struct plant_marker {
+    plant_marker_params p;
+    uint64_t rng;
+    uint32_t k;           /* index of the next marker */
+    double next;          /* its position, noise included */
+    int32_t latch;        /* count at the last marker */
+    uint32_t count;       /* markers so far */
+    int on;               /* a marker during the last step */
+} plant_marker;
+void plant_marker_init(plant_marker *m, const plant_marker_params *p);
+/* The watched position moved from x0 to x1 in the last step. */
+void plant_marker_step(plant_marker *m, double x0, double x1);
+
 /* The same model on a flat array, for C bodies of ST blocks (no structs
 ** cross the ST/C boundary). Indices are fixed: */
 enum {

@@ -8,7 +8,13 @@ $(eval $(call plcrt_program,multiaxis,$(ST_LIB) examples/multiaxis/multiaxis.st)
 $(eval $(call plcrt_program,preset,$(ST_LIB) examples/preset/preset.st))
 $(eval $(call plcrt_program,plcopen,$(ST_LIB) examples/plcopen/plcopen.st))
 $(eval $(call plcrt_program,aposs,$(ST_LIB) examples/aposs/aposs.st))
-EXAMPLES := demo epicpos multiaxis preset plcopen aposs
+CAM_COMMON := $(ST_LIB) examples/cam_common/camaxis.st
+$(eval $(call plcrt_program,cam_stamping,$(CAM_COMMON) examples/cam_stamping/cam_stamping.st))
+$(eval $(call plcrt_program,cam_dryer,$(ST_LIB) examples/cam_dryer/cam_dryer.st))
+$(eval $(call plcrt_program,cam_printing,$(CAM_COMMON) examples/cam_printing/cam_printing.st))
+$(eval $(call plcrt_program,cam_slavesync,$(CAM_COMMON) examples/cam_slavesync/cam_slavesync.st))
+CAM_EXAMPLES := cam_stamping cam_dryer cam_printing cam_slavesync
+EXAMPLES := demo epicpos multiaxis preset plcopen aposs $(CAM_EXAMPLES)
 ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 
 .PHONY: $(EXAMPLES:%=run-%)

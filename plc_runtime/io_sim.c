@@ -2,6 +2,9 @@
 ** io_sim.c: the `sim` backend: up to SIM_AXES simulated axes (plant.h),
 ** each bound to located variables by [sim.axisN] sections. Without any
 ** such section one axis runs with the default bindings (docs/config.md).
+** [sim.master] adds a master axis that runs by itself (or an encoder on
+** one of the axes), [sim.marker0..3] marker sensors on the master or an
+** axis: the plants of the CAM examples.
 */
 #include <math.h>
 #include <stddef.h>
@@ -29,8 +32,37 @@ typedef struct sim_axis {
     int16_t dac;
 } sim_axis;
 
+#define SIM_MARKERS 4
+
+typedef struct sim_master {
+    int used;
+    plant_master_params p;
+    plant_master m;
+    int follow;           /* -1 own motion, else the axis whose load it measures */
+    double ratio;         /* master counts per axis count, with follow */
+    double x, x0;         /* position now and at the step before */
+    plc_loc loc;
+    int bound;
+} sim_master;
+
+enum { M_INPUT, M_LATCH, M_COUNT, NMBIND };
+static const char *mbind_keys[NMBIND] = { "input", "latch", "count" };
+static const char mbind_size[NMBIND] = { 'X', 'D', 'W' };
+
+typedef struct sim_marker {
+    int used;
+    int on;               /* -1 the master, else an axis */
+    plant_marker_params p;
+    plant_marker m;
+    plc_loc loc[NMBIND];
+    int bound[NMBIND];
+    double prev;          /* the axis's position at the step before */
+} sim_marker;
+
 typedef struct sim {
     sim_axis ax[SIM_AXES];
+    sim_master master;
+    sim_marker mk[SIM_MARKERS];
     int configured;       /* any [sim.axisN] seen */
     uint64_t last_ns;
     int started;
@@ -62,11 +94,92 @@ static int num(const char *v, double *out)
     return 0;
 }
 
+/* an input address of the size wanted, into l */
+static int bind_input(const char *v, char size, plc_loc *l, char *err, size_t n)
+{
+    if (plc_loc_parse(v, l)) { snprintf(err, n, "'%s' is not a located address inside the process image", v); return -1; }
+    if (l->size != size) { snprintf(err, n, "'%s' must be a %%..%c address", v, size); return -1; }
+    if (l->area == 'Q') { snprintf(err, n, "'%s' must be an input (%%I or %%M)", v); return -1; }
+    return 0;
+}
+
+static int ranged(const char *v, double lo, double hi, double *out, char *err, size_t n)
+{
+    if (num(v, out) || *out < lo || *out > hi) {
+        snprintf(err, n, "'%s' is not a number in %g..%g", v, lo, hi);
+        return -1;
+    }
+    return 0;
+}
+
+static int axis_ref(const char *v, int *out, char *err, size_t n)
+{
+    unsigned idx;
+    char tail;
+    if (!strcmp(v, "master")) { *out = -1; return 0; }
+    if (sscanf(v, "axis%u%c", &idx, &tail) == 1 && idx < SIM_AXES) { *out = (int)idx; return 0; }
+    snprintf(err, n, "'%s': master or axis0 .. axis7", v);
+    return -1;
+}
+
+static int config_master(sim_master *m, const char *key, const char *v, char *err, size_t n)
+{
+    if (!m->used) { m->used = 1; m->follow = -1; m->ratio = 1; }
+    if (!strcmp(key, "counter")) { m->bound = !bind_input(v, 'D', &m->loc, err, n); return m->bound ? 0 : -1; }
+    if (!strcmp(key, "follow")) {
+        if (!*v) { m->follow = -1; return 0; }
+        if (axis_ref(v, &m->follow, err, n)) return -1;
+        if (m->follow < 0) { snprintf(err, n, "the master cannot follow itself"); return -1; }
+        return 0;
+    }
+    double x;
+    if (!strcmp(key, "speed")) return ranged(v, -1e9, 1e9, &m->p.speed, err, n);
+    if (!strcmp(key, "speed_amp")) return ranged(v, -1e9, 1e9, &m->p.speed_amp, err, n);
+    if (!strcmp(key, "speed_hz")) return ranged(v, 0, 1000, &m->p.speed_hz, err, n);
+    if (!strcmp(key, "start")) return ranged(v, -2147483648.0, 2147483647.0, &m->p.start, err, n);
+    if (!strcmp(key, "ratio")) {
+        if (ranged(v, -1e6, 1e6, &x, err, n)) return -1;
+        m->ratio = x;
+        return 0;
+    }
+    snprintf(err, n, "unknown key");
+    return -1;
+}
+
+static int config_marker(sim_marker *k, const char *key, const char *v, char *err, size_t n)
+{
+    if (!k->used) { k->used = 1; k->on = -1; }
+    for (int i = 0; i < NMBIND; i++) {
+        if (strcmp(key, mbind_keys[i])) continue;
+        if (!*v) { k->bound[i] = 0; return 0; }
+        if (bind_input(v, mbind_size[i], &k->loc[i], err, n)) return -1;
+        k->bound[i] = 1;
+        return 0;
+    }
+    if (!strcmp(key, "on")) return axis_ref(v, &k->on, err, n);
+    if (!strcmp(key, "first")) return ranged(v, -2147483648.0, 2147483647.0, &k->p.first, err, n);
+    if (!strcmp(key, "pitch")) return ranged(v, 0, 2147483647.0, &k->p.pitch, err, n);
+    if (!strcmp(key, "noise")) return ranged(v, 0, 1e9, &k->p.noise, err, n);
+    if (!strcmp(key, "seed")) {
+        double x;
+        if (ranged(v, 0, 4294967295.0, &x, err, n)) return -1;
+        k->p.seed = (uint32_t)x;
+        return 0;
+    }
+    snprintf(err, n, "unknown key");
+    return -1;
+}
+
 static int config(void *st, const char *sec, const char *key, const char *v, char *err, size_t n)
 {
     sim *s = st;
     unsigned idx;
     char tail;
+    if (!strcmp(sec, "sim.master")) return config_master(&s->master, key, v, err, n);
+    if (sscanf(sec, "sim.marker%u%c", &idx, &tail) == 1) {
+        if (idx >= SIM_MARKERS) { snprintf(err, n, "unknown section (markers are [sim.marker0] .. [sim.marker3])"); return -1; }
+        return config_marker(&s->mk[idx], key, v, err, n);
+    }
     if (!strcmp(sec, "sim")) { snprintf(err, n, "unknown key (axes are [sim.axis0] .. [sim.axis7])"); return -1; }
     if (sscanf(sec, "sim.axis%u%c", &idx, &tail) != 1 || idx >= SIM_AXES) {
         snprintf(err, n, "unknown section (axes are [sim.axis0] .. [sim.axis7])");
@@ -143,6 +256,30 @@ static int open_(void *st, plc_image *img, uint64_t tick, char *err, size_t n)
         }
         plant_init(&a->s, &a->p);
     }
+    sim_master *m = &s->master;
+    if (m->used) {
+        if (!m->bound) { snprintf(err, n, "[sim.master]: counter must be set"); return -1; }
+        if (m->follow >= 0 && !s->ax[m->follow].used) {
+            snprintf(err, n, "[sim.master]: follow = axis%d, an axis not simulated", m->follow);
+            return -1;
+        }
+        plant_master_init(&m->m, &m->p);
+    }
+    for (int i = 0; i < SIM_MARKERS; i++) {
+        sim_marker *k = &s->mk[i];
+        if (!k->used) continue;
+        if (k->on < 0 ? !m->used : !s->ax[k->on].used) {
+            if (k->on < 0) snprintf(err, n, "[sim.marker%d]: on = master, and no [sim.master]", i);
+            else snprintf(err, n, "[sim.marker%d]: on = axis%d, an axis not simulated", i, k->on);
+            return -1;
+        }
+        if (k->p.pitch <= 0) { snprintf(err, n, "[sim.marker%d]: pitch must be set (> 0)", i); return -1; }
+        if (k->p.noise >= k->p.pitch / 2) {
+            snprintf(err, n, "[sim.marker%d]: noise must be below half the pitch", i);
+            return -1;
+        }
+        plant_marker_init(&k->m, &k->p);
+    }
     s->started = 0;
     return 0;
 }
@@ -173,6 +310,33 @@ static int rd(void *st, plc_image *img, uint64_t now)
         if (a->bound[B_ZCOUNT]) img_set16(plc_loc_ptr(img, &a->loc[B_ZCOUNT]), 0, (int16_t)(uint16_t)a->s.zeros);
         if (a->bound[B_MCOUNTER]) img_set32(plc_loc_ptr(img, &a->loc[B_MCOUNTER]), 0, plant_motor_counter(&a->s));
         if (a->bound[B_LACC]) img_set32(plc_loc_ptr(img, &a->loc[B_LACC]), 0, acc_dint(a->s.al));
+    }
+    sim_master *m = &s->master;
+    if (m->used) {
+        m->x0 = m->x;
+        if (m->follow >= 0) {
+            m->x = m->p.start + m->ratio * s->ax[m->follow].s.xl;
+        } else {
+            plant_master_step(&m->m, dt);
+            m->x = m->m.x;
+        }
+        if (dt == 0) m->x0 = m->x;
+        img_set32(plc_loc_ptr(img, &m->loc), 0, (int32_t)(uint32_t)(int64_t)floor(m->x));
+    }
+    for (int i = 0; i < SIM_MARKERS; i++) {
+        sim_marker *k = &s->mk[i];
+        if (!k->used) continue;
+        if (k->on < 0) {
+            plant_marker_step(&k->m, m->x0, m->x);
+        } else {
+            /* the axis's load position before and after this step */
+            double x1 = s->ax[k->on].s.xl;
+            plant_marker_step(&k->m, dt == 0 ? x1 : k->prev, x1);
+            k->prev = x1;
+        }
+        if (k->bound[M_INPUT]) *plc_loc_ptr(img, &k->loc[M_INPUT]) = (uint8_t)k->m.on;
+        if (k->bound[M_LATCH]) img_set32(plc_loc_ptr(img, &k->loc[M_LATCH]), 0, k->m.latch);
+        if (k->bound[M_COUNT]) img_set16(plc_loc_ptr(img, &k->loc[M_COUNT]), 0, (int16_t)(uint16_t)k->m.count);
     }
     return 0;
 }

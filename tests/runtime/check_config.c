@@ -151,6 +151,93 @@ START_TEST(sim_modes_run)
 }
 END_TEST
 
+static int sec_set(const io_backend_ops *o, void *st, const char *sec, const char *k, const char *v,
+                   char *e, size_t n)
+{
+    return o->config(st, sec, k, v, e, n);
+}
+
+#define SET(sec, k, v) ck_assert_msg(sec_set(o, st, sec, k, v, e, sizeof e) == 0, "%s %s = %s: %s", sec, k, v, e)
+
+/* [sim.master] and [sim.markerN] in the backend: the master's counter is
+** speed x t (floor), a marker on it pulses at first + k pitch with the count
+** latched there (noise 0), one on an axis fed by the master's follower. */
+START_TEST(sim_master_markers)
+{
+    const io_backend_ops *o = io_backend_find("sim");
+    static plc_image img;
+    char e[300];
+    void *st = o->create();
+    SET("sim.axis0", "dac", "%QW0"); SET("sim.axis0", "counter", "%ID0");
+    SET("sim.master", "counter", "%ID2"); SET("sim.master", "speed", "4000");
+    SET("sim.marker0", "first", "1000"); SET("sim.marker0", "pitch", "1500");
+    SET("sim.marker0", "input", "%IX1.0"); SET("sim.marker0", "latch", "%ID3"); SET("sim.marker0", "count", "%IW8");
+    ck_assert_msg(o->open(st, &img, 0, e, sizeof e) == 0, "%s", e);
+    int pulses = 0;
+    for (int i = 0; i <= 1000; i++) {
+        ck_assert_int_eq(o->read_inputs(st, &img, (uint64_t)i * 1000000), 0);
+        o->write_outputs(st, &img);
+        int32_t x = img_get32(img.id, 2);
+        ck_assert_msg(abs(x - 4 * i) <= 1, "master %d at %d ms, expected %d", x, i, 4 * i);
+        if (img.ix[8]) {      /* %IX1.0: one byte per bit */
+            pulses++;
+            ck_assert_int_eq(img_get32(img.id, 3), 1000 + 1500 * (pulses - 1));
+            ck_assert_msg(x >= img_get32(img.id, 3) && x - 4 <= img_get32(img.id, 3), "pulse late: %d", x);
+        }
+    }
+    ck_assert_int_eq(pulses, 3);      /* 1000, 2500 and 4000: the master reaches 4000 at 1 s */
+    ck_assert_int_eq(img_get16(img.iw, 8), 3);
+    o->close(st);
+
+    /* refused at open: a master without counter, a marker on an absent master, too much noise */
+    st = o->create();
+    SET("sim.master", "speed", "1");
+    ck_assert_int_ne(o->open(st, &img, 0, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[sim.master]: counter must be set"), "%s", e);
+    o->close(st);
+    st = o->create();
+    SET("sim.marker1", "pitch", "100");
+    ck_assert_int_ne(o->open(st, &img, 0, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[sim.marker1]: on = master, and no [sim.master]"), "%s", e);
+    o->close(st);
+    st = o->create();
+    SET("sim.marker0", "on", "axis0"); SET("sim.marker0", "pitch", "100"); SET("sim.marker0", "noise", "50");
+    ck_assert_int_ne(o->open(st, &img, 0, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "noise must be below half the pitch"), "%s", e);
+    o->close(st);
+    bad("[sim.marker4]\npitch = 1\n", "[sim.marker4] pitch: unknown section");
+    bad("[sim.marker0]\non = axis8\n", "'axis8': master or axis0 .. axis7");
+    bad("[sim.master]\nfollow = master\n", "the master cannot follow itself");
+    bad("[sim.master]\ncounter = %QD1\n", "must be an input");
+    bad("[sim.master]\nspeed = fast\n", "'fast' is not a number");
+}
+END_TEST
+
+/* follow: an encoder on an axis: start + ratio x the axis's position */
+START_TEST(sim_master_follow)
+{
+    const io_backend_ops *o = io_backend_find("sim");
+    static plc_image img;
+    char e[300];
+    void *st = o->create();
+    SET("sim.axis1", "dac", "%QW1"); SET("sim.axis1", "counter", "%ID1"); SET("sim.axis1", "lag", "0");
+    SET("sim.axis1", "maxvel", "10000");
+    SET("sim.master", "counter", "%ID2"); SET("sim.master", "follow", "axis1");
+    SET("sim.master", "ratio", "2"); SET("sim.master", "start", "100");
+    ck_assert_msg(o->open(st, &img, 0, e, sizeof e) == 0, "%s", e);
+    img_set16(img.qw, 1, 16384);     /* 5 V: 5000 counts/s */
+    for (int i = 0; i <= 100; i++) {
+        ck_assert_int_eq(o->read_inputs(st, &img, (uint64_t)i * 1000000), 0);
+        o->write_outputs(st, &img);
+    }
+    double ax = 10000 * (16384 * 10.0 / 32767) / 10 * 0.099;   /* 99 ms at speed: the first step starts it */
+    ck_assert_msg(fabs(img_get32(img.id, 1) - ax) <= 6, "axis %d, expected about %.0f", img_get32(img.id, 1), ax);
+    ck_assert_msg(abs(img_get32(img.id, 2) - (100 + 2 * img_get32(img.id, 1))) <= 2, "master %d, axis %d",
+                  img_get32(img.id, 2), img_get32(img.id, 1));
+    o->close(st);
+}
+END_TEST
+
 START_TEST(syntax)
 {
     bad("[plc]\nlog_level = info\nthis line has no equals sign\n", "plant.ini:3: syntax error");
@@ -497,6 +584,8 @@ int main(void)
     tcase_add_test(t, sim_good);
     tcase_add_test(t, sim_modes);
     tcase_add_test(t, sim_modes_run);
+    tcase_add_test(t, sim_master_markers);
+    tcase_add_test(t, sim_master_follow);
     tcase_add_test(t, syntax);
     tcase_add_test(t, unknown);
     tcase_add_test(t, values);

@@ -105,6 +105,61 @@ START_TEST(cam)
 }
 END_TEST
 
+/* master axis: x = start + speed t (+ amp/(2 pi f) (1 - cos 2 pi f t)) */
+START_TEST(master_axis)
+{
+    plant_master m;
+    plant_master_params p = { 4000, 0, 0, 100 };
+    plant_master_init(&m, &p);
+    for (int i = 0; i < 2500; i++) plant_master_step(&m, 1e-3);
+    ck_assert_msg(fabs(m.x - (100 + 4000 * 2.5)) < 1e-6, "master %.6f, expected 10100", m.x);
+    ck_assert_int_ge(plant_master_counter(&m), 10099);
+    ck_assert_int_le(plant_master_counter(&m), 10100);
+    p = (plant_master_params){ 4000, 1000, 2, 0 };
+    plant_master_init(&m, &p);
+    for (int i = 0; i < 125; i++) plant_master_step(&m, 1e-3);        /* a quarter period of 2 Hz */
+    double x = 4000 * 0.125 + 1000 / (2 * M_PI * 2) * (1 - cos(M_PI / 2));
+    ck_assert_msg(fabs(m.x - x) < 1e-6, "master %.6f, expected %.6f", m.x, x);
+    ck_assert_int_eq(plant_master_counter(&m), (int)floor(x));
+}
+END_TEST
+
+/* markers: one pulse per pitch, each within +-noise of first + k pitch, the
+** latch the count there; none backwards; noise 0 exact */
+START_TEST(markers)
+{
+    plant_marker mk;
+    plant_marker_params p = { 1000, 4000, 0, 1 };
+    plant_marker_init(&mk, &p);
+    double x = 0;
+    for (int i = 0; i < 20000; i++) { plant_marker_step(&mk, x, x + 3.0); x += 3.0; }  /* to 60000 */
+    ck_assert_uint_eq(mk.count, 15);                 /* 1000, 5000, ..., 57000 */
+    ck_assert_int_eq(mk.latch, 57000);
+    p.noise = 50;
+    plant_marker_init(&mk, &p);
+    x = 0;
+    int pulses = 0, bad = 0;
+    double lo = 1e9, hi = -1e9;
+    for (int i = 0; i < 20000; i++) {
+        plant_marker_step(&mk, x, x + 3.0);
+        x += 3.0;
+        if (mk.on) {
+            pulses++;
+            double k = round((mk.latch - 1000) / 4000.0), e = mk.latch - (1000 + 4000 * k);
+            if (fabs(e) > 50 || mk.latch > x || mk.latch < x - 3.0 - 1) bad++;
+            if (e < lo) lo = e;
+            if (e > hi) hi = e;
+        }
+    }
+    ck_assert_int_eq(pulses, 15);
+    ck_assert_int_eq(bad, 0);
+    ck_assert_msg(hi - lo > 20, "noise spread %.0f..%.0f: the noise is not applied", lo, hi);
+    uint32_t before = mk.count;
+    for (int i = 0; i < 5000; i++) { plant_marker_step(&mk, x, x - 3.0); x -= 3.0; }
+    ck_assert_uint_eq(mk.count, before);
+}
+END_TEST
+
 int main(void)
 {
     Suite *su = suite_create("plant");
@@ -114,6 +169,8 @@ int main(void)
     tcase_add_test(t, dead_band_offset_drift);
     tcase_add_test(t, resonance);
     tcase_add_test(t, cam);
+    tcase_add_test(t, master_axis);
+    tcase_add_test(t, markers);
     suite_add_tcase(su, t);
     return check_run(su);
 }
