@@ -352,10 +352,16 @@ try:
            r.returncode == 0 and rows[0] == ["time_ms", "cycle", f"{P}COUNT", f"{P}TOGGLE"], r.stderr + str(rows[0]))
     if len(rows) == 201:
         d = rows[1:]
-        report("its rows: 200 samples, time 0 ms at the trigger (sample 10, a rise), 1 ms apart",
+        # one sample a cycle: consecutive cycle numbers; PLC time 1 ms apart,
+        # or a whole number of periods where the machine made plcrt skip one
+        steps = [float(d[i + 1][0]) - float(d[i][0]) for i in range(199)]
+        report("its rows: 200 samples of consecutive cycles, time 0 ms at the trigger (sample 10, a rise), "
+               "1 ms apart (whole periods across a skipped one)",
                float(d[10][0]) == 0 and d[10][3] == "1" and d[9][3] == "0"
-               and all(abs(float(d[i][0]) - (i - 10)) < 1e-9 for i in range(200))
-               and all(int(x[2]) == int(x[1]) + 1 for x in d), str(d[8:12]))
+               and all(int(d[i + 1][1]) == int(d[i][1]) + 1 for i in range(199))
+               and all(st >= 1 - 1e-9 and abs(st - round(st)) < 1e-9 for st in steps)
+               and all(int(x[2]) == int(x[1]) + 1 for x in d),
+               f"{str(d[8:12])}; steps other than 1 ms: {[s for s in steps if abs(s - 1) > 1e-9][:5]}")
     else:
         report("its rows: 200 samples", False, f"{len(rows) - 1} rows")
     png = csvp[:-4] + ".png"
