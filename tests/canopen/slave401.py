@@ -280,6 +280,17 @@ class CanDump:
             worst = max(worst, fr[k][0] - last)
         return last, worst, seen
 
+    def outputs_safe_check(self, node, t_stop, hb_cons, cob_ids):
+        """(ok, detail) for the deadline: node's RPDOs (cob_ids) turn to zeros
+        within two consumer times of its last heartbeat and stay so."""
+        last, dt, seen = self.outputs_after_loss(node, t_stop, cob_ids)
+        if last is None:
+            return False, "no heartbeat recorded"
+        if dt is None:
+            return False, f"RPDOs to node {node} not zero until it boots again ({seen} seen)"
+        return dt <= 2 * hb_cons, (f"RPDOs to node {node} zero from {dt * 1000:.0f} ms after its last "
+                                   f"heartbeat on, limit {2 * hb_cons * 1000:.0f} ms ({seen} RPDOs until it boots again)")
+
     def close(self, keep):
         self.stop()
         if keep:
