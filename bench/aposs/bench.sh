@@ -45,3 +45,19 @@ awk -v m1="$med1" -v m="$med256" -v p="$p99256" -v x="$max256" 'BEGIN {
         m / 1e4, p / 1e4, x / 1e4, (p <= 1e6 ? "FIT" : "DO NOT FIT")
     printf "bench-aposs: axes that fit 1 ms at the p99 cost per axis: %d\n", int(1e6 / (p / 256))
 }'
+
+# The tuning tool's final gains on examples/aposs beside a hand tuning of
+# the same plant (bench/aposs/gains.st): the peak following error of the
+# tool's standard move, POSA 50000 qc at VEL 100, ACC 100.
+d="$out/gains"
+rm -rf "$d" && mkdir -p "$d"
+cat "$lib" "$top/c_blocks/sim_axis.st" "$here/gains.st" > "$d/all.st"
+st_compile "$d/all.st" "$d" "bench-aposs/gains" || exit 1
+st_link "$d" "$here/gains.c" "$d/prog" "bench-aposs/gains" -I "$top/c_blocks" "$top/c_blocks/plant.c" || exit 1
+"$d/prog" 1200 > "$d/out.txt" || exit 1
+read -r _ tool _ hand _ kp _ kd _ bad _ same < "$d/out.txt"
+[ "$bad" = 0 ] || { echo "bench-aposs: FAIL: $bad axes in error in the gains comparison"; exit 1; }
+awk -v t="$tool" -v h="$hand" -v kp="$kp" -v kd="$kd" -v s="$same" 'BEGIN {
+    printf "bench-aposs: peak following error, POSA 50000 qc: tool gains (FFVEL 875, FFACC 24, KPROP 504, KDER 200, BANDWIDTH 58) %.2f qc; best hand tuning of 35 (FFVEL 875, FFACC 26, KPROP %d, KDER %d) %.2f qc; hand feed-forwards at KPROP 500, KDER 200 %.2f qc\n", t / 1000, kp, kd, h / 1000, s / 1000
+    printf "bench-aposs: the tool'"'"'s peak following error no larger than the hand tuning'"'"'s: %s (ratio %.2f)\n", (t <= h ? "yes" : "NO"), t / h
+}'
