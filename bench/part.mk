@@ -72,3 +72,12 @@ bench-isg: $(STC) $(ST_LIB)
 	@env STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" CFLAGS="$(CFLAGS)" \
 	  bench/isg/run.sh $(BENCH_B)/isg $(ST_LIB)
 BENCHES += bench-isg
+
+# APOSSAXIS: ns per 1 ms scan with 256 axes in limited-jerk motion, each on
+# its own simulated plant, beside one axis; whether 256 fit 1 ms on one
+# core, and the cost per axis (bench/aposs/)
+.PHONY: bench-aposs
+bench-aposs: $(STC) $(ST_LIB)
+	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
+	  bench/aposs/bench.sh $(BENCH_B)/aposs $(abspath $(ST_LIB))
+BENCHES += bench-aposs
