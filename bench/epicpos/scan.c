@@ -24,6 +24,7 @@ IEC_TIME __CURRENT_TIME;
 BOOL __DEBUG;
 #define __LOCATED_VAR(type, name, ...) type __s##name; type *name = &__s##name;
 #include "LOCATED_VARIABLES.h"
+#include "../common/bench_clock.h"
 #undef __LOCATED_VAR
 
 static unsigned long tick;
@@ -40,18 +41,6 @@ static void scan(void)
 
 __attribute__((noinline)) static void scan_counted(void) { scan(); }
 
-static long long now_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1000000000LL + t.tv_nsec;
-}
-
-static int cmp_ll(const void *a, const void *b)
-{
-    long long x = *(const long long *)a, y = *(const long long *)b;
-    return (x > y) - (x < y);
-}
 
 int main(int argc, char **argv)
 {
