@@ -75,9 +75,10 @@ BENCHES += bench-isg
 
 # APOSSAXIS: ns per 1 ms scan with 256 axes in limited-jerk motion, each on
 # its own simulated plant, beside one axis; whether 256 fit 1 ms on one
-# core, and the cost per axis (bench/aposs/)
+# core, and the cost per axis; the tuning tool run on examples/aposs and its
+# gains beside hand tunings of the same plant (bench/aposs/)
 .PHONY: bench-aposs
-bench-aposs: $(STC) $(ST_LIB)
+bench-aposs: $(STC) $(ST_LIB) $(BUILD)/plc/aposs/plcrt
 	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
-	  bench/aposs/bench.sh $(BENCH_B)/aposs $(abspath $(ST_LIB))
+	  bench/aposs/bench.sh $(BENCH_B)/aposs $(abspath $(ST_LIB)) 3000 5 $(abspath $(BUILD)/plc/aposs/plcrt)
 BENCHES += bench-aposs

@@ -1,8 +1,7 @@
 /*
- * Run the gains comparison program (bench/aposs/gains.st) for a number of
- * 1 ms ticks and print its figures on one line:
- * "tool_peak_mqc T hand_peak_mqc H hand_kprop P hand_kder D bad B
- * samefb_peak_mqc S" (%QD0..%QD5).
+ * Run the gains comparison program (bench/aposs/gains.st.in) for a number
+ * of 1 ms ticks and print its figures (%QD0..%QD13, named in the program's
+ * header comment) on one line, "name value" pairs, peaks in 1/1000 qc.
  *   gains ticks
  */
 #include <stdlib.h>
@@ -12,8 +11,8 @@
 int main(int argc, char **argv)
 {
     long n = argc == 2 ? atol(argv[1]) : 0;
-    int32_t *q[6];
-    for (int i = 0; i < 6; i++) {
+    int32_t *q[14];
+    for (int i = 0; i < 14; i++) {
         char name[8];
         snprintf(name, sizeof name, "%%QD%d", i);
         q[i] = located(name, NULL);
@@ -21,7 +20,7 @@ int main(int argc, char **argv)
             n = 0;
     }
     if (n < 1) {
-        fprintf(stderr, "usage: %s ticks (program with %%QD0..%%QD5)\n", argv[0]);
+        fprintf(stderr, "usage: %s ticks (program with %%QD0..%%QD13)\n", argv[0]);
         return 2;
     }
     config_init__();
@@ -29,7 +28,11 @@ int main(int argc, char **argv)
         config_run__((unsigned long)i);
         tick_clock();
     }
-    printf("tool_peak_mqc %ld hand_peak_mqc %ld hand_kprop %ld hand_kder %ld bad %ld samefb_peak_mqc %ld\n",
-           (long)*q[0], (long)*q[1], (long)*q[2], (long)*q[3], (long)*q[4], (long)*q[5]);
+    static const char *const label[14] = {
+        "tool", "tool_worst", "model", "grid", "grid_kprop", "grid_kder", "grid_ffacc",
+        "load_tool", "load_model", "load_grid", "load_grid_kprop", "load_grid_kder", "load_grid_ffacc", "bad" };
+    for (int i = 0; i < 14; i++)
+        printf("%s%s %ld", i ? " " : "", label[i], (long)*q[i]);
+    printf("\n");
     return 0;
 }
