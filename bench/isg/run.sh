@@ -23,3 +23,14 @@ echo "== ISGDAMP through EPICPOS: the seed's procedure on the 53 Hz plant"
 echo "== ISGDAMP's cost per sample (DIRECT, order 2; EPICPOS does not call it while isg_enable is FALSE)"
 "$d/isg_cost" 300000 | awk '{ print "  " ($2 == 0 ? "disabled" : $2 " stages") ": " $4 " ns per call"; ns[$2] = $4 }
     END { printf "  per stage (3 stages - 1 stage) / 2: %.1f ns per sample\n", (ns[3] - ns[1]) / 2 }'
+# the same stage through APOSSAXIS (aposs.st, with the TRUN scenario of
+# tests/apossaxis/t_isg.st)
+d=$out/aposs
+rm -rf "$d" && mkdir -p "$d"
+{ cat "$lib" "$top/c_blocks/sim_axis.st" "$top/tests/epicpos/tsupport.st"
+  sed -n '/^FUNCTION_BLOCK TRUN/,/^END_FUNCTION_BLOCK/p' "$top/tests/apossaxis/t_isg.st"
+  cat "$here/aposs.st"; } > "$d/all.st"
+st_compile "$d/all.st" "$d" isg/aposs
+st_link "$d" "$here/report.c" "$d/report" isg/aposs -I "$top/c_blocks" "$top/c_blocks/plant.c"
+echo "== ISGDAMP through APOSSAXIS: the seed's procedure on the 53 Hz plant"
+"$d/report" "$here/aposs.st" 20000
