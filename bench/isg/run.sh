@@ -2,7 +2,8 @@
 # make bench-isg: ISGDAMP through EPICPOS on the simulated plant, the seed's
 # procedure's figures (figures.st, with the TRUN scenario of
 # tests/isg/t_epicpos.st), the seed's two-mode case, robustness and the
-# position gain (seedcase.st, with the blocks of tests/isg/t_seedcase.st)
+# position gain (seedcase.st, with the blocks of tests/isg/t_seedcase.st),
+# the stability limits by analysis (gain_analysis.py, numpy/scipy)
 # and the cost per stage per sample (cost.c).
 #   bench/isg/run.sh OUTDIR LIBRARY.st
 # Environment: STC, STC_INC, CC, CFLAGS.
@@ -31,6 +32,8 @@ st_compile "$d2/all.st" "$d2" isg/seedcase
 st_link "$d2" "$here/report.c" "$d2/report" isg/seedcase -I "$top/c_blocks" "$top/c_blocks/plant.c"
 echo "== ISGDAMP on the seed's two-mode plant (53 Hz DIRECT, 11 Hz INDIRECT), force step, detuning, position gain"
 "$d2/report" "$here/seedcase.st" 10
+echo "== the highest stable position gain by analysis (closed-loop eigenvalues, scipy; gain_analysis.py)"
+python3 "$here/gain_analysis.py"
 "$CC" $CFLAGS -I "$STC_INC" -I "$d/c" -I "$top/c_blocks" -o "$d/isg_cost" \
     "$here/cost.c" "$top/c_blocks/plant.c" -lm
 echo "== ISGDAMP's cost per sample (DIRECT, order 2; EPICPOS does not call it while isg_enable is FALSE)"
