@@ -17,8 +17,8 @@ G = 1e-6  # counts/s^2 -> 10^6 counts/s^2 on the axes
 
 
 def main():
-    rows = np.array([list(map(float, l.split()[1:6])) for l in open(sys.argv[1]) if l.startswith("ROW ")])
-    t, off, on, vadd, vset = rows.T
+    rows = np.array([list(map(float, l.split()[1:8])) for l in open(sys.argv[1]) if l.startswith("ROW ")])
+    t, off, on, vadd, vset, eoff, eon = rows.T
     out = sys.argv[2]
 
     # 1. the forward move: ramps, the 53 Hz shaker while driving, the stop
@@ -57,6 +57,19 @@ def main():
     ax[1].legend(loc="upper right")
     fig.tight_layout()
     fig.savefig(f"{out}/isg-seed-zoom.png", dpi=90)
+
+    # 3. the position gain: a setpoint step at Kv 25 1/s on the fast drive
+    fig, ax = plt.subplots(figsize=(10, 3.5))
+    m = t < 2.0
+    ax.plot(t[m], eoff[m], lw=0.8, label="without damping (stable up to Kv 18)")
+    ax.plot(t[m], eon[m], lw=0.8, label="DIRECT 53 Hz, Q 2, 20/200 (stable up to Kv 33)")
+    ax.set_ylim(-1100, 1100)
+    ax.set_title("1000-count setpoint step at Kv 25 1/s: 2 ms drive, loop on the load encoder, 53 Hz at zeta 0.02")
+    ax.set_xlabel("time after the step (s)")
+    ax.set_ylabel("following error (counts)")
+    ax.legend(loc="lower right")
+    fig.tight_layout()
+    fig.savefig(f"{out}/isg-gain-step.png", dpi=90)
 
 
 if __name__ == "__main__":
