@@ -14,9 +14,10 @@ position gain") and tests/isg/t_seedcase.st, independent of the ST code.
             edges pre-warped), times the weight, added to v
 
 The loop is stable when every eigenvalue of the one-sample state map lies
-inside the unit circle; the highest stable Kv is found on a 0.5 grid from
-0.5.  Printed: that Kv and the frequency of the eigenvalue that leaves the
-circle there (the oscillation that limits the gain).
+inside the unit circle; the highest stable Kv is found on a grid from 0.5
+(steps of 0.5 up to 1000, then of 1 %).  Printed: that Kv and the frequency
+of the eigenvalue that leaves the circle there (the oscillation that limits
+the gain); last, a stiff load, for what the 1 ms sampling alone allows.
 
     gain_analysis.py
 """
@@ -93,7 +94,7 @@ def closed_loop(kv, tau, hz, zeta, stage):
     return np.column_stack([step(np.eye(n)[j]) for j in range(n)])
 
 
-def highest(tau, hz, zeta, stage, kvmax=3000):
+def highest(tau, hz, zeta, stage, kvmax=5000):
     kv, last = 0.5, None
     while kv <= kvmax:
         ev = np.linalg.eigvals(closed_loop(kv, tau, hz, zeta, stage))
@@ -101,7 +102,7 @@ def highest(tau, hz, zeta, stage, kvmax=3000):
         if abs(ev[i]) >= 1:
             return last, abs(np.angle(ev[i])) / (2 * np.pi * TS)
         last = kv
-        kv += 0.5
+        kv += 0.5 if kv < 1000 else 0.01 * kv     # 0.5 up to 1000, then 1 %
     return last, float("nan")
 
 
@@ -117,6 +118,9 @@ def main():
     for name, tau, stage in cases:
         kv, f = highest(tau, 53.0, 0.02, stage)
         print(f"  {name}: highest stable Kv {kv:g} 1/s, then unstable at {f:.1f} Hz")
+    # a stiff load (its mode at 1000 Hz, well damped): what the sampling allows
+    kv, f = highest(0.02, 1000.0, 0.7, None)
+    print(f"  20 ms drive, stiff load (mode at 1000 Hz, zeta 0.7): highest stable Kv {kv:g} 1/s, then unstable at {f:.1f} Hz")
 
 
 if __name__ == "__main__":
