@@ -1,7 +1,8 @@
-# PLCopen tests: ST programs driving the MC_* blocks over an EPICPOS axis on
-# the simulated plant (c_blocks/sim_axis.st), compiled with $(STC) and run by
-# the EPICPOS harness (see run.sh); with both compilers (the adapter owns
-# its device: no block instance is passed as a parameter).
+# PLCopen tests: ST programs driving the MC_* blocks over EPICPOS and
+# APOSS-style axes on the simulated plant (c_blocks/sim_axis.st), compiled
+# with $(STC) and run by the EPICPOS harness (see run.sh); with both
+# compilers (the adapters own their devices: no block instance is passed as
+# a parameter).
 PLCOPEN_TESTS := $(wildcard tests/plcopen/t_*.st)
 
 TESTS += test-plcopen
