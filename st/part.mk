@@ -5,7 +5,7 @@ ST_LIB_SRC := st/epicutil.st st/epicprof.st st/ljprof.st st/poscount.st st/pidff
               st/apossctl.st st/prssearch.st st/zlatch.st st/epicpos.st \
               st/plcopen_axis.st st/plcopen.st
 ST_LIB_SRC += st/camcurve.st st/cambox.st st/camsync.st
-ST_LIB_SRC += st/apossaxis.st
+ST_LIB_SRC += st/apossaxis.st st/plcopen_aposs.st
 ST_LIB_SRC += st/plcopen_sync.st
 ST_LIB     := $(BUILD)/st/epicpos.st
 

@@ -9,12 +9,13 @@ EX_RUN = mk/suite.sh $(RESULTS) examples-$(1) python3 tests/examples/test_$(1).p
 
 .PHONY: test-examples
 test-examples: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/multiaxis/plcrt $(BUILD)/plc/preset/plcrt \
-	       $(EX_CAM:%=$(BUILD)/plc/%/plcrt)
+	       $(BUILD)/plc/plcopen/plcrt $(EX_CAM:%=$(BUILD)/plc/%/plcrt)
 	@rm -rf $(EX_T) && mkdir -p $(EX_T)
 	@rc=0; \
 	$(call EX_RUN,epicpos) || rc=1; \
 	$(call EX_RUN,multiaxis) || rc=1; \
 	$(call EX_RUN,preset) || rc=1; \
+	$(call EX_RUN,plcopen) || rc=1; \
 	$(foreach e,$(EX_CAM),$(call EX_RUN,$(e)) || rc=1; )\
 	exit $$rc
 TESTS += test-examples

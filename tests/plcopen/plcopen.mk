@@ -1,12 +1,12 @@
-# PLCopen tests: ST programs driving the MC_* blocks over an EPICPOS axis on
-# the simulated plant (c_blocks/sim_axis.st), compiled with $(STC) and run by
-# the EPICPOS harness (see run.sh).
+# PLCopen tests: ST programs driving the MC_* blocks over EPICPOS and
+# APOSS-style axes on the simulated plant (c_blocks/sim_axis.st), compiled
+# with $(STC) and run by the EPICPOS harness (see run.sh); with both
+# compilers (the adapters own their devices: no block instance is passed as
+# a parameter).
 PLCOPEN_TESTS := $(wildcard tests/plcopen/t_*.st)
 
 TESTS += test-plcopen
-# not in MATIEC_TESTS: the programs hand an EPICPOS instance to
-# MC_AXIS_EPICPOS, and matiec cannot pass a function block instance as a
-# parameter (docs/stc.md, "ST for both compilers")
+MATIEC_TESTS += test-plcopen
 
 .PHONY: test-plcopen
 test-plcopen: $(ST_LIB) $(STC)
