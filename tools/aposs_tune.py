@@ -12,10 +12,11 @@ the map).  Each test run is a POSA recorded cycle by cycle with the trace
   5  KPROP raised until the axis oscillates at standstill after the move,
      then set to 70 % of that value
   6  KDER from 200 raised by half while the oscillation (the peak following
-     error of the move plus the oscillation at standstill, the mean of
-     --repeat runs) falls; the search stops where it grows (by a quarter, or
-     two steps beyond the best) and keeps the best value tried (if 200 is
-     already worse than none, the same search downwards: 100, 50, ...)
+     error of the move plus the oscillation at standstill, the median of
+     --repeat runs) falls; the search stops where it grows by a quarter and half a count, and
+     keeps the value that is best together with its neighbours on the
+     ladder (if 200 is already worse than none, the same search downwards:
+     100, 50, ...)
   7  KINT only if a static following error remains
   9  BANDWIDTH lowered to twice what the PID needs in the test move (more
      if the move then follows worse than unclamped)
@@ -313,36 +314,43 @@ class Tuner:
 
         def kd_measure(**gains):                                        # step 6
             # the oscillation of a run: the peak following error over the
-            # move plus the oscillation left at standstill; the mean over
-            # --repeat runs (there and back), as one count of the encoder
-            # is as large as the following error of a well tuned move
+            # move plus the oscillation left at standstill; the median of
+            # --repeat runs (there and back), as one count of the encoder is
+            # as large as the following error of a well tuned move, and a
+            # scan a few tenths of a ms late (the plant moved on meanwhile)
+            # adds tens of counts to one run at full speed
             ms = []
             for _ in range(a.repeat):
                 c = self.run(**gains)
                 ms.append(self.fe_peak(c) + self.standstill(c)[1])
                 gains = {}
-            return sum(ms) / len(ms)
+            ms.sort()
+            return ms[len(ms) // 2] if len(ms) % 2 else (ms[len(ms) // 2 - 1] + ms[len(ms) // 2]) / 2
         bestm = kd_measure(KPROP=self.kprop, KDER=0, KINT=0)
         log(f"KDER 0: peak following error + standstill oscillation {bestm:.2f} qc")
         tried = {0: bestm}
         kd, up = 200, True
-        while 1 <= kd <= 65000:
+        while 1 <= kd <= 65000 and len(tried) < 12:
             m = tried[kd] = kd_measure(KDER=kd)
             log(f"KDER {kd}: peak following error + standstill oscillation {m:.2f} qc")
-            best = min(tried, key=tried.get)
             if up and kd == 200 and m > tried[0]:
                 # already worse at the seed's 200 (its scale is the machine's):
                 # the same search downwards
                 up, kd = False, 100
                 continue
-            # the oscillations begin to increase: clearly worse than the
-            # best so far, or no better two steps running
-            worse = [k for k in sorted(tried, reverse=not up) if (k > best if up else k < best)]
-            if m > 1.25 * tried[best] or len(worse) >= 2:
+            # the oscillations begin to increase: clearly worse than the best,
+            # by more than the encoder's rounding
+            if m > 1.25 * min(tried.values()) + 0.5:
                 break
             kd = round(kd * 1.5) if up else kd // 2
-        self.kder = min(tried, key=tried.get)
-        log(f"KDER {self.kder}: the least oscillation of {sorted(tried)}")
+        # a run's peak moves by a count with where the encoder's edges fall:
+        # the value kept is the middle of the best stretch, each value judged
+        # with its neighbours on the ladder
+        ks = sorted(tried)
+        smooth = {k: sum(tried[j] for j in ks[max(0, i - 1):i + 2]) / len(ks[max(0, i - 1):i + 2])
+                  for i, k in enumerate(ks)}
+        self.kder = min(smooth, key=smooth.get)
+        log(f"KDER {self.kder}: the least oscillation with its neighbours of {ks}")
         ax.set("KDER", self.kder)
 
         c = self.run()                                                  # step 7
@@ -415,8 +423,8 @@ def main(argv=None):
                     help="RMS following error at standstill (qc) that counts as oscillating")
     ap.add_argument("--retries", type=int, default=3,
                     help="times a run disturbed by a late scan is made again")
-    ap.add_argument("--repeat", type=int, default=2,
-                    help="test runs per KDER value (there and back), their mean judged")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="test runs per KDER and BANDWIDTH value, their median judged")
     ap.add_argument("--samples", type=int, default=1200, help="trace samples per run (1 per cycle)")
     a = ap.parse_args(argv)
     ax = Axis(a.host, a.port)
