@@ -39,6 +39,7 @@ import importlib.machinery
 import importlib.util
 import math
 import os
+import statistics
 import struct
 import sys
 import threading
@@ -312,7 +313,7 @@ class Tuner:
         self.kprop = max(1, round(0.7 * bad))
         log(f"KPROP: mild oscillation from {bad}: 70 % = {self.kprop}")
 
-        def kd_measure(**gains):                                        # step 6
+        def oscillation(**gains):                                       # step 6
             # the oscillation of a run: the peak following error over the
             # move plus the oscillation left at standstill; the median of
             # --repeat runs (there and back), as one count of the encoder is
@@ -324,14 +325,13 @@ class Tuner:
                 c = self.run(**gains)
                 ms.append(self.fe_peak(c) + self.standstill(c)[1])
                 gains = {}
-            ms.sort()
-            return ms[len(ms) // 2] if len(ms) % 2 else (ms[len(ms) // 2 - 1] + ms[len(ms) // 2]) / 2
-        bestm = kd_measure(KPROP=self.kprop, KDER=0, KINT=0)
+            return statistics.median(ms)
+        bestm = oscillation(KPROP=self.kprop, KDER=0, KINT=0)
         log(f"KDER 0: peak following error + standstill oscillation {bestm:.2f} qc")
         tried = {0: bestm}
         kd, up = 200, True
         while 1 <= kd <= 65000 and len(tried) < 12:
-            m = tried[kd] = kd_measure(KDER=kd)
+            m = tried[kd] = oscillation(KDER=kd)
             log(f"KDER {kd}: peak following error + standstill oscillation {m:.2f} qc")
             if up and kd == 200 and m > tried[0]:
                 # already worse at the seed's 200 (its scale is the machine's):
@@ -365,12 +365,12 @@ class Tuner:
 
         c = self.run(BANDWIDTH=1000)                                    # step 9
         peak = max(abs(x) for x in c["PIDPART"])
-        ref = kd_measure()
+        ref = oscillation()
         bw = max(1, min(1000, math.ceil(2 * 1000 * peak / 32767)))
         log(f"PID part at most {peak:.0f} DAC bits: BANDWIDTH {bw} to try")
         while bw < 1000:
             # the clamp must not cost accuracy: the move as good as unclamped
-            m = kd_measure(BANDWIDTH=bw)
+            m = oscillation(BANDWIDTH=bw)
             log(f"BANDWIDTH {bw}: peak following error + standstill oscillation {m:.2f} qc (unclamped {ref:.2f})")
             if m <= 1.1 * ref:
                 break
