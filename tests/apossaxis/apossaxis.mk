@@ -12,8 +12,8 @@ test-apossaxis: $(ST_LIB) $(STC)
 	    CFLAGS="$(CFLAGS)" tests/apossaxis/run.sh $(BUILD)/tests/apossaxis $(ST_LIB) $(APOSSAXIS_TESTS)
 
 # test-apossaxis-tune: the seed 001 tuning procedure (tools/aposs_tune.py) on
-# the APOSS example under plcrt, over Modbus and the trace (about 45 s: some
-# 25 test moves in real time)
+# the APOSS example under plcrt, over Modbus and the trace (1.5 to 3 min:
+# some 50 test moves in real time, more where scans come late)
 TESTS += test-apossaxis-tune
 .PHONY: test-apossaxis-tune
 test-apossaxis-tune: $(BUILD)/plc/aposs/plcrt

@@ -28,7 +28,7 @@ def main():
     plc = Plcrt(exe, cfg, work, "aposs-tune")
     try:
         r = subprocess.run([sys.executable, os.path.join(HERE, "..", "..", "tools", "aposs_tune.py"),
-                            "--port", str(port), "--out", work], capture_output=True, text=True, timeout=150)
+                            "--port", str(port), "--out", work], capture_output=True, text=True, timeout=400)
         with open(os.path.join(work, "tune.out"), "w") as f:
             f.write(r.stdout + r.stderr)
         report("apossaxis/tune: the tool ran to its end (no error on the axis, no POSERR trip)",
