@@ -51,7 +51,7 @@ awk -v m1="$med1" -v m="$med256" -v p="$p99256" -v x="$max256" 'BEGIN {
 # The tuning tool run on examples/aposs under plcrt (as make test does),
 # then its final gains beside hand tunings of the same plant
 # (bench/aposs/gains.st.in): the peak following error of the tool's standard
-# move, POSA 50000 qc at VEL 100, ACC 100, the mean over 8 starting positions.
+# move, POSA 50000 qc at VEL 100, ACC 100, the mean over 32 starting positions.
 d="$out/gains"
 rm -rf "$d" && mkdir -p "$d"
 if [ -n "$plcrt" ]; then
@@ -76,10 +76,10 @@ read -r _ tm _ tw _ mm _ gm _ gkp _ gkd _ gff _ ltm _ lmm _ lgm _ lkp _ lkd _ lf
 [ "$bad" = 0 ] || { echo "bench-aposs: FAIL: $bad axes in error in the gains comparison"; exit 1; }
 awk -v tm="$tm" -v tw="$tw" -v mm="$mm" -v gm="$gm" -v gkp="$gkp" -v gkd="$gkd" -v gff="$gff" \
     -v ltm="$ltm" -v lmm="$lmm" -v lgm="$lgm" -v lkp="$lkp" -v lkd="$lkd" -v lff="$lff" 'BEGIN {
-    printf "bench-aposs: peak following error of the standard move (POSA 50000 qc), mean of 8 starts, encoder (load):\n"
+    printf "bench-aposs: peak following error of the standard move (POSA 50000 qc), mean of 32 starts, encoder (load):\n"
     printf "bench-aposs:   tool gains                                     %.3f (%.3f) qc, worst start %.2f qc\n", tm / 1000, ltm / 1000, tw / 1000
     printf "bench-aposs:   careful tuning from the plant data (KPROP 161, KDER 804) %.3f (%.3f) qc\n", mm / 1000, lmm / 1000
     printf "bench-aposs:   best of 70 trials on the encoder figure (FFACC %d, KPROP %d, KDER %d) %.3f qc; on the load figure (FFACC %d, KPROP %d, KDER %d) %.3f qc\n", gff, gkp, gkd, gm / 1000, lff, lkp, lkd, lgm / 1000
-    printf "bench-aposs: the tool'"'"'s peak following error no larger than the careful tuning'"'"'s: encoder %s (ratio %.3f), load %s (ratio %.3f)\n", (tm <= mm ? "yes" : "NO"), tm / mm, (ltm <= lmm ? "yes" : "NO"), ltm / lmm
+    printf "bench-aposs: the tool'"'"'s peak following error no larger than the careful tuning'"'"'s: encoder %s (ratio %.3f, %+.3f qc), load %s (ratio %.3f, %+.3f qc)\n", (tm <= mm ? "yes" : "NO"), tm / mm, (tm - mm) / 1000, (ltm <= lmm ? "yes" : "NO"), ltm / lmm, (ltm - lmm) / 1000
     printf "bench-aposs: ... than the best of 70 trials: encoder %s (ratio %.3f, %+.3f qc), load %s (ratio %.3f, %+.3f qc); one count is 1 qc\n", (tm <= gm ? "yes" : "NO"), tm / gm, (tm - gm) / 1000, (ltm <= lgm ? "yes" : "NO"), ltm / lgm, (ltm - lgm) / 1000
 }'
