@@ -100,6 +100,9 @@ def main():
     # to 7 % at 1 ms: the cases must include ones where that shows
     hard = [r for cid, r in coef.items() if cid < 1000 and r[1] * r[2] >= 0.2 and r[3] == 1.0]
     report("cases near the limit fg_f0 = fs/4 at Q 1 included", len(hard) >= 3, f"{len(hard)}")
+    # and at the other end: fg_f0 x ts = 1e-6 is the lowest ISGDAMP accepts
+    low = [r for cid, r in coef.items() if cid < 1000 and r[1] * r[2] <= 1.0001e-6]
+    report("cases at the low limit fg_f0 = fs/1e6 included", len(low) >= 9, f"{len(low)}")
 
     for cid, name in ((1000, "DIRECT"), (1001, "INDIRECT"), (1002, "SET_POINT")):
         r, seq = coef.get(cid), imp.get(cid, [])
