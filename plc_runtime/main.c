@@ -37,7 +37,7 @@ static void usage(FILE *f)
         "      --check-config  check the configuration (file, program, this host) and exit\n"
         "  -h, --help          this text\n"
         "  -V, --version       version and linked program\n"
-        "Signals: SIGINT/SIGTERM stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",
+        "Signals: SIGINT/SIGTERM/SIGHUP/SIGQUIT stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",
         plc_program_linked.name, *plc_program_linked.ticktime / 1e6);
 }
 
@@ -189,6 +189,32 @@ static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc
         fprintf(stderr, "plcrt: outputs safe (DAC 0 V), retain saved to %s\n", cfg->retain_file);
 }
 
+static const char *sig_name(int sig)
+{
+    switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP (the terminal closed)";
+    case SIGQUIT: return "SIGQUIT";
+    default: return "a signal";
+    }
+}
+
+/* A stop signal already pending (taken), or 0. */
+static int stop_pending(const sigset_t *sigs)
+{
+    sigset_t p;
+    if (sigpending(&p)) return 0;
+    static const int stops[] = { SIGINT, SIGTERM, SIGHUP, SIGQUIT };
+    for (size_t i = 0; i < sizeof stops / sizeof stops[0]; i++)
+        if (sigismember(&p, stops[i])) {
+            struct timespec zero = { 0, 0 };
+            sigtimedwait(sigs, NULL, &zero);
+            return stops[i];
+        }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     static const struct option opts[] = {
@@ -223,6 +249,17 @@ int main(int argc, char **argv)
         return 0;
     }
 
+    /* From here on a stop signal is taken by the housekeeping loop (or the
+    ** check before the first cycle below), never by its default action: the
+    ** backend may hold outputs from its open on, and they go to their safe
+    ** state on every way out. SIGHUP (the terminal closed) and SIGQUIT
+    ** (Ctrl-backslash) stop the way SIGTERM does. */
+    sigset_t sigs;
+    sigemptyset(&sigs);
+    sigaddset(&sigs, SIGINT); sigaddset(&sigs, SIGTERM); sigaddset(&sigs, SIGHUP); sigaddset(&sigs, SIGQUIT);
+    sigaddset(&sigs, SIGUSR1); sigaddset(&sigs, SIGPIPE);
+    pthread_sigmask(SIG_BLOCK, &sigs, NULL);
+
     /* retain */
     retained ret = {0};
     if (retained_setup(&ret, prog)) { fprintf(stderr, "plcrt: out of memory\n"); return 1; }
@@ -237,13 +274,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "plcrt: %s: backend %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", cfg.backend, err);
         return 2;
     }
-
-    /* signals: handled by this thread only */
-    sigset_t sigs;
-    sigemptyset(&sigs);
-    sigaddset(&sigs, SIGINT); sigaddset(&sigs, SIGTERM); sigaddset(&sigs, SIGUSR1);
-    sigaddset(&sigs, SIGPIPE);
-    pthread_sigmask(SIG_BLOCK, &sigs, NULL);
 
     static scan sc;
     sc.prog = prog; sc.io = cfg.io; sc.io_state = cfg.io_state; sc.mb = mb;
@@ -296,6 +326,16 @@ int main(int argc, char **argv)
         CPU_SET(cfg.cpu, &set);
         pthread_attr_setaffinity_np(&at, sizeof set, &set);
     }
+    /* a stop asked for during the start-up: no cycle runs at all */
+    int early = stop_pending(&sigs);
+    if (early) {
+        mb_server_stop(srv);
+        cfg.io->safe_state(cfg.io_state, &plc_img);
+        cfg.io->close(cfg.io_state);
+        fprintf(stderr, "plcrt: %s during the start-up: stopped before the first cycle, outputs safe (DAC 0 V), "
+                "retain file untouched\n", sig_name(early));
+        return 0;
+    }
     pthread_t th;
     int rt_ok = 0;
     if (cfg.priority > 0) {
@@ -329,8 +369,8 @@ int main(int argc, char **argv)
     for (;;) {
         struct timespec to = { 0, 200000000 };
         int sig = sigtimedwait(&sigs, NULL, &to);
-        if (sig == SIGINT || sig == SIGTERM) {
-            if (sig == SIGTERM) plc_log(LOG_INFO, "SIGTERM: stopping");
+        if (sig == SIGINT || sig == SIGTERM || sig == SIGHUP || sig == SIGQUIT) {
+            if (sig != SIGINT) plc_log(LOG_INFO, "%s: stopping", sig_name(sig));
             else if (isatty(2)) fputc('\n', stderr);   /* past the terminal's ^C */
             stop_sig = sig;
             break;

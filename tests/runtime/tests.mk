@@ -114,3 +114,11 @@ test-runtime-trace: $(BUILD)/plc/rt_trace/plcrt
 	@mk/suite.sh $(RESULTS) runtime-trace python3 tests/runtime/test_trace.py \
 	  $(BUILD)/plc/rt_trace/plcrt $(abspath $(RT_T))/trace
 TESTS += test-runtime-trace
+# every stop signal (SIGHUP, SIGQUIT too) the orderly way out, and a stop
+# asked for during the start-up before any cycle (docs/runtime.md)
+.PHONY: test-runtime-signals
+test-runtime-signals: $(BUILD)/plc/rt_iotest/plcrt
+	@mk/suite.sh $(RESULTS) runtime-signals python3 tests/runtime/test_signals.py \
+	  $(BUILD)/plc/rt_iotest/plcrt $(abspath $(RT_T))/signals
+TESTS += test-runtime-signals
+MATIEC_TESTS += test-runtime-signals
