@@ -138,7 +138,10 @@ static int num(const char *v, unsigned long max, unsigned long *out, char *err, 
 {
     char *end;
     errno = 0;
-    unsigned long x = strtoul(v, &end, 0);
+    /* decimal, or hexadecimal with 0x: never octal, so that id = 010 is
+    ** node 10 (as every other integer of the file), not node 8 */
+    int hex = v[0] == '0' && (v[1] == 'x' || v[1] == 'X');
+    unsigned long x = strtoul(v, &end, hex ? 16 : 10);
     while (*end == ' ' || *end == '\t')
         end++;
     if (errno || end == v || *end || *v == '-' || x > max) {
