@@ -73,6 +73,7 @@ static const struct key {
     { "scan", "cpu", K_INT, -1, 1023, F(cpu) },
     { "scan", "lock_memory", K_BOOL, 0, 0, F(lock_memory) },
     { "scan", "overrun_log_interval", K_INT, 1, 3600, F(overrun_log_interval) },
+    { "scan", "watchdog_ms", K_INT, 0, 3600000, F(watchdog_ms) },
     { "io", "backend", K_BACKEND, 0, 0, F(backend) },
     { "modbus", "enabled", K_BOOL, 0, 0, F(mb_enabled) },
     { "modbus", "bind", K_BIND, 0, 0, F(mb_bind) },
@@ -548,6 +549,7 @@ int config_defaults(plc_config *c, char *err, size_t errlen)
     c->cpu = -1;
     c->lock_memory = 1;
     c->overrun_log_interval = 1;
+    c->watchdog_ms = 500;
     strcpy(c->backend, "sim");
     c->mb_enabled = 1;
     strcpy(c->mb_bind, "127.0.0.1");

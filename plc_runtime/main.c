@@ -215,6 +215,35 @@ static int stop_pending(const sigset_t *sigs)
     return 0;
 }
 
+/* The program has not returned within [scan] watchdog_ms (an endless loop,
+** say): the scan no longer touches the I/O (scan_watchdog), so the outputs
+** are put in their safe state from here, and plcrt ends with status 3. The
+** scan thread is stuck in the program: it cannot hand over a consistent
+** copy of the retained variables, so the retain file keeps the last
+** generation saved. */
+static _Noreturn void watchdog_halt(scan *sc, mb_server *srv, plc_config *cfg)
+{
+    double ms = (double)(scan_now_ns() - atomic_load(&sc->program_ns)) / 1e6;
+    plc_log(LOG_ERROR, "watchdog: the program has been running for %.0f ms in one cycle, beyond [scan] watchdog_ms "
+            "= %d (an endless loop? a loop bound from a variable?): outputs to their safe state, plcrt stops",
+            ms, cfg->watchdog_ms);
+    mb_server_stop(srv);
+    memset(plc_img.qx, 0, sizeof plc_img.qx);
+    memset(plc_img.qb, 0, sizeof plc_img.qb);
+    memset(plc_img.qw, 0, sizeof plc_img.qw);
+    memset(plc_img.qd, 0, sizeof plc_img.qd);
+    memset(plc_img.ql, 0, sizeof plc_img.ql);
+    cfg->io->safe_state(cfg->io_state, &plc_img);
+    if (!cfg->retain_file[0])
+        fprintf(stderr, "plcrt: stopped by the watchdog: outputs safe (DAC 0 V), nothing retained\n");
+    else
+        fprintf(stderr, "plcrt: stopped by the watchdog: outputs safe (DAC 0 V), retain NOT saved: %s keeps "
+                "the generation saved last\n", cfg->retain_file);
+    fflush(stdout);
+    fflush(stderr);
+    _exit(3);
+}
+
 int main(int argc, char **argv)
 {
     static const struct option opts[] = {
@@ -366,9 +395,15 @@ int main(int argc, char **argv)
     scan_sample ss[CFG_MAX_STATUS];
     for (int i = 0; i < cfg.nstatus; i++)
         ss[i] = (scan_sample){ plc_var_addr(status[i]), sbuf[i], status[i]->size <= 64 ? status[i]->size : 64 };
+    /* the watchdog looks a few times within its time */
+    long wd_ns = cfg.watchdog_ms ? (long)cfg.watchdog_ms * 1000000 / 4 : 200000000;
+    if (wd_ns > 200000000) wd_ns = 200000000;
+    if (wd_ns < 10000000) wd_ns = 10000000;
     for (;;) {
-        struct timespec to = { 0, 200000000 };
+        struct timespec to = { 0, wd_ns };
         int sig = sigtimedwait(&sigs, NULL, &to);
+        if (scan_watchdog(&sc, (uint64_t)cfg.watchdog_ms * 1000000u))
+            watchdog_halt(&sc, srv, &cfg);
         if (sig == SIGINT || sig == SIGTERM || sig == SIGHUP || sig == SIGQUIT) {
             if (sig != SIGINT) plc_log(LOG_INFO, "%s: stopping", sig_name(sig));
             else if (isatty(2)) fputc('\n', stderr);   /* past the terminal's ^C */

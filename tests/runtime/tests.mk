@@ -122,3 +122,10 @@ test-runtime-signals: $(BUILD)/plc/rt_iotest/plcrt
 	  $(BUILD)/plc/rt_iotest/plcrt $(abspath $(RT_T))/signals
 TESTS += test-runtime-signals
 MATIEC_TESTS += test-runtime-signals
+# the watchdog: a program that never returns puts the outputs in their safe
+# state and stops plcrt (status 3); long cycles do not trip it
+.PHONY: test-runtime-watchdog
+test-runtime-watchdog: $(BUILD)/plc/rt_spin/plcrt
+	@mk/suite.sh $(RESULTS) runtime-watchdog python3 tests/runtime/test_watchdog.py \
+	  $(BUILD)/plc/rt_spin/plcrt $(abspath $(RT_T))/watchdog
+TESTS += test-runtime-watchdog
