@@ -264,6 +264,11 @@ int main(int argc, char **argv)
         }
     }
     if (optind < argc) { fprintf(stderr, "plcrt: unexpected argument '%s'\n", argv[optind]); usage(stderr); return 2; }
+    if (file && !*file) {            /* plcrt -c "$CFG" with CFG unset */
+        fprintf(stderr, "plcrt: -c needs the name of a configuration file (an empty name was given; "
+                "leave -c out for the defaults)\n");
+        return 2;
+    }
 
     static plc_config cfg;
     const plc_program *prog = &plc_program_linked;
@@ -333,6 +338,17 @@ int main(int argc, char **argv)
         mb_publish(mb, &plc_img, diag);
     }
 
+    /* a stop asked for during the start-up: no cycle runs at all, and no
+    ** client has been told a write was taken (the server is not started:
+    ** from its start on, a stop takes the orderly way, writes landed) */
+    int early = stop_pending(&sigs);
+    if (early) {
+        cfg.io->safe_state(cfg.io_state, &plc_img);
+        cfg.io->close(cfg.io_state);
+        fprintf(stderr, "plcrt: %s during the start-up: stopped before the first cycle, outputs safe (DAC 0 V), "
+                "retain file untouched\n", sig_name(early));
+        return 0;
+    }
     mb_server *srv = NULL;
     if (mb && !(srv = mb_server_start(&cfg, mb, err, sizeof err))) {
         /* found only now: the port taken since the check, for instance */
@@ -354,16 +370,6 @@ int main(int argc, char **argv)
         CPU_ZERO(&set);
         CPU_SET(cfg.cpu, &set);
         pthread_attr_setaffinity_np(&at, sizeof set, &set);
-    }
-    /* a stop asked for during the start-up: no cycle runs at all */
-    int early = stop_pending(&sigs);
-    if (early) {
-        mb_server_stop(srv);
-        cfg.io->safe_state(cfg.io_state, &plc_img);
-        cfg.io->close(cfg.io_state);
-        fprintf(stderr, "plcrt: %s during the start-up: stopped before the first cycle, outputs safe (DAC 0 V), "
-                "retain file untouched\n", sig_name(early));
-        return 0;
     }
     pthread_t th;
     int rt_ok = 0;

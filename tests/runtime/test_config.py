@@ -111,6 +111,11 @@ if a:
 refused("-c FOLDER: an error naming the folder", WORK, f"{WORK}: is a folder, not a configuration file")
 refused("-c FOLDER: the start refuses it too", WORK, f"{WORK}: is a folder", False)
 
+# an empty name (a shell variable left unset: plcrt -c "$CFG")
+refused("-c '': says a file name is missing (was ': No such file or directory')", "",
+        "-c needs the name of a configuration file")
+refused("-c '': the start refuses it too", "", "-c needs the name of a configuration file", False)
+
 # long lines: a valid status_vars line of 234 characters, line numbers after it
 names = ["TICKS", "KEEP_REAL", "QW_ECHO", "IW_FIRST", "QX_LAST", "IX_LAST", "IW_LAST", "KEEP"]
 line = "status_vars = " + ", ".join(VAR + n for n in names)
