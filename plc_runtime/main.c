@@ -303,9 +303,23 @@ int main(int argc, char **argv)
             scan_sample_now(NULL, ret.back, ret.n, 0, 0);
     }
 
+    /* the Modbus port before any I/O: a second plcrt started on the same
+    ** configuration stops here, before its backend could reset the nodes
+    ** the first one drives */
+    mb_server *srv = NULL;
+    if (mb && !(srv = mb_server_listen(&cfg, mb, err, sizeof err))) {
+        int e = errno;
+        char msg[800];
+        config_msg(&cfg, "modbus", e == EADDRINUSE || e == EACCES ? "port" : "bind", msg, sizeof msg, "%s%s", err,
+                   e == EADDRINUSE ? " (another plcrt running on this configuration? nothing was opened)" : "");
+        fprintf(stderr, "plcrt: %s\n", msg);
+        return 2;
+    }
+
     /* I/O */
     if (cfg.io->open(cfg.io_state, &plc_img, period, err, sizeof err)) {
         fprintf(stderr, "plcrt: %s: backend %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", cfg.backend, err);
+        mb_server_stop(srv);
         return 2;
     }
 
@@ -339,25 +353,23 @@ int main(int argc, char **argv)
     }
 
     /* a stop asked for during the start-up: no cycle runs at all, and no
-    ** client has been told a write was taken (the server is not started:
-    ** from its start on, a stop takes the orderly way, writes landed) */
+    ** client has been told a write was taken (nothing served yet: from
+    ** mb_server_run on, a stop takes the orderly way, writes landed) */
     int early = stop_pending(&sigs);
     if (early) {
+        mb_server_stop(srv);
         cfg.io->safe_state(cfg.io_state, &plc_img);
         cfg.io->close(cfg.io_state);
         fprintf(stderr, "plcrt: %s during the start-up: stopped before the first cycle, outputs safe (DAC 0 V), "
                 "retain file untouched\n", sig_name(early));
         return 0;
     }
-    mb_server *srv = NULL;
-    if (mb && !(srv = mb_server_start(&cfg, mb, err, sizeof err))) {
-        /* found only now: the port taken since the check, for instance */
-        int e = errno;
-        char msg[800];
-        config_msg(&cfg, "modbus", e == EADDRINUSE || e == EACCES ? "port" : "bind", msg, sizeof msg, "%s", err);
-        fprintf(stderr, "plcrt: %s\n", msg);
+    if (srv && mb_server_run(srv, err, sizeof err)) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        mb_server_stop(srv);
+        cfg.io->safe_state(cfg.io_state, &plc_img);
         cfg.io->close(cfg.io_state);
-        return 2;
+        return 1;
     }
 
     if (cfg.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE))

@@ -167,6 +167,16 @@ with socket.socket() as busy:
     report("a port in use passes --check-config (a running plcrt may hold it)", rc == 0, "" if rc == 0 else out)
     refused("a port in use: the start names [modbus] port, status 2", path,
             f"{path}:4: [modbus] port: cannot listen on 127.0.0.1:{port}", False)
+    # a second plcrt on the port of a running one stops before its backend
+    # opens anything (a CANopen master would reset the nodes the first one
+    # drives): here the CAN interface does not even exist, and the message
+    # is about the port, not about the interface
+    path = write("busy-can.ini", f"[io]\nbackend = canopen\n[modbus]\nport = {port}\n[canopen]\n"
+                 "interface = nocan9\n[canopen.io1]\nid = 5\n[retain]\nfile =\n")
+    rc, out = run(path, False)
+    report("a port in use: refused before the backend is opened (no CAN interface touched)",
+           rc == 2 and f"{path}:4: [modbus] port: cannot listen" in out and "another plcrt" in out
+           and "nocan9" not in out and "backend canopen" not in out, f"status {rc}: {out.strip()[-400:]}")
 
 Plcrt.kill_all()
 sys.exit(0 if report.all_passed() else 1)
