@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/mman.h>
 #include <time.h>
 #include <unistd.h>
@@ -189,6 +191,32 @@ static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc
         fprintf(stderr, "plcrt: outputs safe (DAC 0 V), retain saved to %s\n", cfg->retain_file);
 }
 
+/* One plcrt per retain file: two would save their generations over each
+** other's (and each load the other's). FILE.lock holds the owner's pid
+** under an flock that ends with the process. 0, or -1 with a message. */
+static int retain_lock(const plc_config *c, char *err, size_t n)
+{
+    char lock[sizeof c->retain_file + 8];
+    snprintf(lock, sizeof lock, "%s.lock", c->retain_file);
+    int fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        config_msg(c, "retain", "file", err, n, "cannot create %s: %s", lock, strerror(errno));
+        return -1;
+    }
+    if (flock(fd, LOCK_EX | LOCK_NB)) {
+        char pid[24] = "";
+        ssize_t r = read(fd, pid, sizeof pid - 1);
+        pid[r > 0 ? r : 0] = 0;
+        pid[strcspn(pid, "\n")] = 0;
+        config_msg(c, "retain", "file", err, n, "%s is in use by another plcrt (pid %s): two would overwrite each "
+                   "other's generations; give each its own [retain] file", c->retain_file, pid[0] ? pid : "?");
+        close(fd);
+        return -1;
+    }
+    if (ftruncate(fd, 0) == 0) dprintf(fd, "%d\n", (int)getpid());
+    return 0;                        /* fd stays open, and locked, until the end */
+}
+
 static const char *sig_name(int sig)
 {
     switch (sig) {
@@ -297,6 +325,10 @@ int main(int argc, char **argv)
     /* retain */
     retained ret = {0};
     if (retained_setup(&ret, prog)) { fprintf(stderr, "plcrt: out of memory\n"); return 1; }
+    if (cfg.retain_file[0] && ret.n && retain_lock(&cfg, err, sizeof err)) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        return 2;
+    }
     if (cfg.retain_file[0] && ret.n) {
         scan_sample_now(NULL, ret.smp, ret.n, 0, 0);     /* initial values as default */
         if (!retain_load(cfg.retain_file, ret.rv, ret.n, &ret.gen))

@@ -178,5 +178,18 @@ with socket.socket() as busy:
            rc == 2 and f"{path}:4: [modbus] port: cannot listen" in out and "another plcrt" in out
            and "nocan9" not in out and "backend canopen" not in out, f"status {rc}: {out.strip()[-400:]}")
 
+# two plcrt on one retain file (two ports): the second is refused, naming
+# the first's pid, before it loads or saves anything
+shared = os.path.join(WORK, "shared.retain")
+first = Plcrt(PLCRT, write("shared1.ini", f"[io]\nbackend = none\n[modbus]\nport = {free_port()}\n"
+                                          f"[retain]\nfile = {shared}\n"), WORK, "shared")
+path = write("shared2.ini", f"[io]\nbackend = none\n[modbus]\nport = {free_port()}\n[retain]\nfile = {shared}\n")
+refused("a retain file in use by another plcrt: refused, naming it and its pid", path,
+        f"{path}:6: [retain] file: {shared} is in use by another plcrt (pid {first.p.pid})", False)
+first.stop()
+second = Plcrt(PLCRT, path, WORK, "shared")
+report("once the first stopped, the second starts on the file", second.alive())
+second.stop()
+
 Plcrt.kill_all()
 sys.exit(0 if report.all_passed() else 1)
