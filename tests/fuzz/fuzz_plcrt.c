@@ -20,6 +20,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "config.h"
+#include "log.h"
 #include "mbmap.h"
 #include "retain.h"
 #include "tracemb.h"
@@ -58,6 +59,7 @@ static char retain_path[64];
 static void init(void)
 {
     char err[700];
+    plc_log_level(LOG_ERROR);                 /* the forcing log would drown the output */
     if (config_defaults(&cfg, err, sizeof err) || config_load_string(&cfg, "fuzz.ini", symbols, err, sizeof err)
         || !(m = mb_new(&cfg, &prog, err, sizeof err))) {
         fprintf(stderr, "fuzz_plcrt: set-up: %s\n", err);
