@@ -315,11 +315,17 @@ int main(int argc, char **argv)
     ** check before the first cycle below), never by its default action: the
     ** backend may hold outputs from its open on, and they go to their safe
     ** state on every way out. SIGHUP (the terminal closed) and SIGQUIT
-    ** (Ctrl-backslash) stop the way SIGTERM does. */
+    ** (Ctrl-backslash) stop the way SIGTERM does, unless plcrt was started
+    ** with them ignored (nohup): blocked, they would be queued and taken. */
     sigset_t sigs;
     sigemptyset(&sigs);
-    sigaddset(&sigs, SIGINT); sigaddset(&sigs, SIGTERM); sigaddset(&sigs, SIGHUP); sigaddset(&sigs, SIGQUIT);
+    sigaddset(&sigs, SIGINT); sigaddset(&sigs, SIGTERM);
     sigaddset(&sigs, SIGUSR1); sigaddset(&sigs, SIGPIPE);
+    static const int optional[] = { SIGHUP, SIGQUIT };
+    for (size_t i = 0; i < sizeof optional / sizeof optional[0]; i++) {
+        struct sigaction sa;
+        if (sigaction(optional[i], NULL, &sa) == 0 && sa.sa_handler != SIG_IGN) sigaddset(&sigs, optional[i]);
+    }
     pthread_sigmask(SIG_BLOCK, &sigs, NULL);
 
     /* retain */

@@ -15,7 +15,7 @@ import sys
 from pymodbus.client import ModbusTcpClient
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Plcrt, Report, free_port  # noqa: E402
+from peer import Plcrt, Report, free_port, wait_for  # noqa: E402
 
 PLCRT, WORK = sys.argv[1], sys.argv[2]
 report = Report("signals")
@@ -72,6 +72,31 @@ def test_stop_signals():
                f"retained {got}, written {value}")
 
 
+def test_nohup():
+    """Started under nohup (SIGHUP ignored), plcrt outlives the terminal."""
+    port = free_port()
+    cfg = ini(port, os.path.join(WORK, "nohup.retain"))
+    log = open(os.path.join(WORK, "nohup.log"), "w+")
+    p = subprocess.Popen([PLCRT, "-c", cfg], stdout=log, stderr=subprocess.STDOUT,
+                         preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
+    try:
+        ok = wait_for(lambda: "running CONFIG0" in open(log.name).read(), 10)
+        p.send_signal(signal.SIGHUP)
+        try:
+            p.wait(timeout=1)
+        except subprocess.TimeoutExpired:
+            pass
+        alive = p.poll() is None
+        p.send_signal(signal.SIGTERM)
+        rc = p.wait(timeout=10)
+        report("under nohup (SIGHUP ignored): SIGHUP leaves plcrt running; SIGTERM still stops it, status 0",
+               ok and alive and rc == 0, f"started {ok}, alive after SIGHUP {alive}, rc {rc}")
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+
+
 def test_stop_during_start_up():
     """A SIGTERM that comes while plcrt is starting (here: already pending
     when it starts, a pending signal survives exec) stops it before the
@@ -112,7 +137,7 @@ def main():
     for f in os.listdir(WORK):
         os.unlink(os.path.join(WORK, f))
     try:
-        for t in (test_stop_signals, test_stop_during_start_up):
+        for t in (test_stop_signals, test_nohup, test_stop_during_start_up):
             try:
                 t()
             except Exception as e:  # noqa: BLE001
