@@ -360,6 +360,14 @@ try:
     report("plctrace force gain 010: ten, as everywhere in plcrt (not octal 8): scaled 100",
            r.returncode == 0 and wait_for(lambda: hreg(9000) == 100, 2), f"{r.stderr} scaled {hreg(9000)}")
     pt("unforce", "--all")
+    # the forcing table full (64): plctrace said "busy: another client owns
+    # the trace"; now it says how many are forced and what to do
+    full = [cmd(c, 0, FORCE, a32(lookup(c, f"spare[{k}]")) + [0, 0, 0, k]) for k in range(1, 65)]
+    r = pt("force", "gain", "3")
+    report("plctrace force with 64 variables forced: says the table is full and how to release one",
+           full == [0] * 64 and r.returncode == 1 and "64 variables are forced, the most plcrt forces at once" in r.stderr
+           and "plctrace unforce PATH" in r.stderr, f"{full.count(0)} forced; {r.stderr[-300:]}")
+    pt("unforce", "--all")
     missing = os.path.join(WORK, "no-such-folder", "rec.csv")
     r = pt("record", "--chan", "count", "--samples", "100", "--no-plot", "-o", missing)
     report("plctrace record -o into a missing folder: refused before the capture (not lost after it)",
