@@ -634,6 +634,30 @@ START_TEST(careless_backend)
     ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
     ck_assert_msg(strstr(e, "both have id 9"), "%s", e);
     o->close(st);
+    /* two nodes bound to one input: refused before the bus is opened; one
+    ** output driving two objects is fine */
+    st = o->create();
+#define CO(sec, k, v) ck_assert_msg(o->config(st, sec, k, v, e, sizeof e) == 0, "%s %s = %s: %s", sec, k, v, e)
+    CO("canopen.left", "id", "1"); CO("canopen.right", "id", "2");
+    CO("canopen.left", "bind", "0x6000:01 %IB4"); CO("canopen.right", "bind", "0x6000:01 %IB4");
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[canopen.left] bind 0x6000:01 %IB4 and [canopen.right] bind 0x6000:01 %IB4 "
+                            "write the same input"), "%s", e);
+    o->close(st);
+    st = o->create();
+    CO("canopen.left", "id", "1"); CO("canopen.right", "id", "2");
+    CO("canopen.left", "bind", "0x6000:01.3 %IX2.0"); CO("canopen.right", "ok", "%IX2.0");
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[canopen.left] bind 0x6000:01.3 %IX2.0 and [canopen.right] ok %IX2.0"), "%s", e);
+    o->close(st);
+    st = o->create();              /* apart, and one %QB to both nodes: on to the bus (none here) */
+    CO("canopen.left", "id", "1"); CO("canopen.right", "id", "2"); CO("canopen", "interface", "nocan9");
+    CO("canopen.left", "bind", "0x6000:01 %IB4"); CO("canopen.right", "bind", "0x6000:01 %IB5");
+    CO("canopen.left", "bind", "0x6200:01 %QB4"); CO("canopen.right", "bind", "0x6200:01 %QB4");
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(!strstr(e, "same input") && strstr(e, "nocan9"), "%s", e);
+    o->close(st);
+#undef CO
     bad("[io]\nbackend = canopen\n[canopen.a]\nid = 3\nid = 4\n",
         "plant.ini:5: [canopen.a] id: given twice (first on line 4)");
 }
