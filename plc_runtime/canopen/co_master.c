@@ -324,6 +324,10 @@ void co_master_rx(co_master *m, const co_frame *f, co_time now)
         co_emcy e;
         if (!co_emcy_decode(f, &e))
             emcy(m, n, &e);
+        else                        /* too short for an error code: still news */
+            logf_(m, 1, "node %u: EMCY frame of %u byte(s), 8 expected: no error code to report (the node "
+                  "signals an emergency it does not describe, or sends on 0x%03X what is no EMCY)",
+                  n->cfg.id, (unsigned)f->len, (unsigned)f->id);
     } else if (fc >= CO_FC_TPDO1 && fc < CO_FC_TPDO1 + 0x100 * CO_PDO_PER_NODE && (fc & 0x80)) {
         unsigned k = (fc - CO_FC_TPDO1) / 0x100;
         unsigned need = (co_pdo_bits(&n->cfg.tpdo[k]) + 7) / 8;

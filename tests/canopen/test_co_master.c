@@ -363,6 +363,12 @@ START_TEST(emcy_logged_and_flagged)
     co_master_rx(&m, &e, T0);
     ck_assert(!(n[0].fault & CO_F_EMCY));
     ck_assert_uint_eq(n[0].emcy_count, 1);
+    /* an EMCY too short for its error code: ignored before, now said */
+    logbuf[0] = 0;
+    e = frame(0x083, 1, (uint8_t[]){ 0x10 });
+    co_master_rx(&m, &e, T0);
+    ck_assert_msg(strstr(logbuf, "E node 3: EMCY frame of 1 byte(s), 8 expected: no error code to report"), "%s",
+                  logbuf);
     /* bus-off error frame */
     co_frame bo = frame(CO_ERR_FLAG | 0x40, 8, (uint8_t[]){ 0, 0, 0, 0, 0, 0, 0, 0 });
     co_master_rx(&m, &bo, T0);
