@@ -51,6 +51,9 @@ typedef struct parse {
     char long_key[CFG_MAX_LINE + 1];
     char long_value[CFG_MAX_LINE + 1];
     char section[64];                   /* the last [section] read, for messages */
+    /* the backend's keys read so far, for "given twice" */
+    struct { char section[64], key[64]; int line; } seen[256];
+    int nseen;
 } parse;
 
 /* ---- the runtime's own keys ---------------------------------------------- */
@@ -70,6 +73,7 @@ static const struct key {
     { "scan", "cpu", K_INT, -1, 1023, F(cpu) },
     { "scan", "lock_memory", K_BOOL, 0, 0, F(lock_memory) },
     { "scan", "overrun_log_interval", K_INT, 1, 3600, F(overrun_log_interval) },
+    { "scan", "watchdog_ms", K_INT, 0, 3600000, F(watchdog_ms) },
     { "io", "backend", K_BACKEND, 0, 0, F(backend) },
     { "modbus", "enabled", K_BOOL, 0, 0, F(mb_enabled) },
     { "modbus", "bind", K_BIND, 0, 0, F(mb_bind) },
@@ -333,6 +337,27 @@ static const io_backend_ops *owner(const char *s)
     return NULL;
 }
 
+/* A backend's key given twice in a section (or in two sections of the same
+** name) would silently replace the first: refused, naming the first line,
+** as for the runtime's own keys. `bind` ([canopen.NODE]) is the one key
+** meant to repeat. 1 when refused. */
+static int backend_twice(parse *p, const char *s, const char *key)
+{
+    if (!strcmp(key, "bind")) return 0;
+    for (int i = 0; i < p->nseen; i++)
+        if (!strncmp(p->seen[i].section, s, sizeof p->seen[i].section - 1)
+            && !strncmp(p->seen[i].key, key, sizeof p->seen[i].key - 1)) {
+            fail(p, s, key, "given twice (first on line %d)", p->seen[i].line);
+            return 1;
+        }
+    if (p->nseen < (int)(sizeof p->seen / sizeof p->seen[0])) {
+        snprintf(p->seen[p->nseen].section, sizeof p->seen[0].section, "%.63s", s);
+        snprintf(p->seen[p->nseen].key, sizeof p->seen[0].key, "%.63s", key);
+        p->seen[p->nseen++].line = p->line;
+    }
+    return 0;
+}
+
 static int handler(void *user, const char *s, const char *key, const char *v)
 {
     parse *p = user;
@@ -348,6 +373,7 @@ static int handler(void *user, const char *s, const char *key, const char *v)
     const io_backend_ops *o = owner(s);
     if (!o) return fail(p, s, key, "unknown section");
     if (o != c->io) return 1;                  /* another backend's: ignored */
+    if (backend_twice(p, s, key)) return 0;
     char e[300] = "";
     if (o->config(c->io_state, s, key, v, e, sizeof e))
         return fail(p, s, key, "%s", e[0] ? e : "rejected");
@@ -523,6 +549,7 @@ int config_defaults(plc_config *c, char *err, size_t errlen)
     c->cpu = -1;
     c->lock_memory = 1;
     c->overrun_log_interval = 1;
+    c->watchdog_ms = 500;
     strcpy(c->backend, "sim");
     c->mb_enabled = 1;
     strcpy(c->mb_bind, "127.0.0.1");

@@ -21,7 +21,7 @@
 #define CFG_MAX_STATUS 8
 #define CFG_MAX_LINE 2048       /* characters in one line, newline excluded */
 #define CFG_MAX_FILE (1 << 20)  /* bytes in one file */
-#define CFG_NKEYS 17            /* keys of the runtime's own sections */
+#define CFG_NKEYS 18            /* keys of the runtime's own sections */
 
 enum { MB_COILS, MB_DISCRETE, MB_INPUT, MB_HOLDING };
 
@@ -45,6 +45,7 @@ typedef struct plc_config {
     int cpu;                            /* -1 = any */
     int lock_memory;
     int overrun_log_interval;           /* s */
+    int watchdog_ms;                    /* one cycle's program at most; 0 = off */
     /* [io] */
     char backend[32];
     const io_backend_ops *io;

@@ -89,7 +89,8 @@ static int num(const char *v, double *out)
 {
     char *end;
     double x = strtod(v, &end);
-    if (end == v || *end) return -1;
+    /* nan passes every range check and inf makes the plant nan: refused */
+    if (end == v || *end || !isfinite(x)) return -1;
     *out = x;
     return 0;
 }
@@ -238,10 +239,46 @@ static int config(void *st, const char *sec, const char *key, const char *v, cha
     return -1;
 }
 
+/* Every signal the plant writes into the image in a place of its own: two
+** axes copied from one section, say, would both write one counter and each
+** position loop would follow the other's encoder. (Two axes may read one
+** DAC: two drives on one speed reference.) 0, or -1 naming both. */
+static int inputs_apart(sim *s, plc_image *img, char *err, size_t n)
+{
+    struct { const uint8_t *p; unsigned w; char who[40]; } in[SIM_AXES * NBIND + 1 + SIM_MARKERS * NMBIND];
+    int k = 0;
+    for (int i = 0; i < SIM_AXES; i++)
+        for (int b = B_COUNTER; b < NBIND && s->ax[i].used; b++)
+            if (s->ax[i].bound[b]) {
+                in[k].p = plc_loc_ptr(img, &s->ax[i].loc[b]);
+                in[k].w = plc_loc_width(&s->ax[i].loc[b]);
+                snprintf(in[k++].who, sizeof in[0].who, "[sim.axis%d] %s", i, bind_keys[b]);
+            }
+    if (s->master.used && s->master.bound) {
+        in[k].p = plc_loc_ptr(img, &s->master.loc);
+        in[k].w = plc_loc_width(&s->master.loc);
+        snprintf(in[k++].who, sizeof in[0].who, "[sim.master] counter");
+    }
+    for (int i = 0; i < SIM_MARKERS; i++)
+        for (int b = 0; b < NMBIND && s->mk[i].used; b++)
+            if (s->mk[i].bound[b]) {
+                in[k].p = plc_loc_ptr(img, &s->mk[i].loc[b]);
+                in[k].w = plc_loc_width(&s->mk[i].loc[b]);
+                snprintf(in[k++].who, sizeof in[0].who, "[sim.marker%d] %s", i, mbind_keys[b]);
+            }
+    for (int i = 0; i < k; i++)
+        for (int j = 0; j < i; j++)
+            if (in[i].p < in[j].p + in[j].w && in[j].p < in[i].p + in[i].w) {
+                snprintf(err, n, "%s and %s write the same input: give each its own address", in[j].who, in[i].who);
+                return -1;
+            }
+    return 0;
+}
+
 static int open_(void *st, plc_image *img, uint64_t tick, char *err, size_t n)
 {
     sim *s = st;
-    (void)img; (void)tick;
+    (void)tick;
     for (int i = 0; i < SIM_AXES; i++) {
         sim_axis *a = &s->ax[i];
         if (!a->used) continue;
@@ -281,7 +318,7 @@ static int open_(void *st, plc_image *img, uint64_t tick, char *err, size_t n)
         plant_marker_init(&k->m, &k->p);
     }
     s->started = 0;
-    return 0;
+    return inputs_apart(s, img, err, n);
 }
 
 /* counts/s^2 rounded, saturated to DINT */

@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/mman.h>
 #include <time.h>
 #include <unistd.h>
@@ -37,7 +39,7 @@ static void usage(FILE *f)
         "      --check-config  check the configuration (file, program, this host) and exit\n"
         "  -h, --help          this text\n"
         "  -V, --version       version and linked program\n"
-        "Signals: SIGINT/SIGTERM stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",
+        "Signals: SIGINT/SIGTERM/SIGHUP/SIGQUIT stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",
         plc_program_linked.name, *plc_program_linked.ticktime / 1e6);
 }
 
@@ -189,6 +191,87 @@ static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc
         fprintf(stderr, "plcrt: outputs safe (DAC 0 V), retain saved to %s\n", cfg->retain_file);
 }
 
+/* One plcrt per retain file: two would save their generations over each
+** other's (and each load the other's). FILE.lock holds the owner's pid
+** under an flock that ends with the process. 0, or -1 with a message. */
+static int retain_lock(const plc_config *c, char *err, size_t n)
+{
+    char lock[sizeof c->retain_file + 8];
+    snprintf(lock, sizeof lock, "%s.lock", c->retain_file);
+    int fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        config_msg(c, "retain", "file", err, n, "cannot create %s: %s", lock, strerror(errno));
+        return -1;
+    }
+    if (flock(fd, LOCK_EX | LOCK_NB)) {
+        char pid[24] = "";
+        ssize_t r = read(fd, pid, sizeof pid - 1);
+        pid[r > 0 ? r : 0] = 0;
+        pid[strcspn(pid, "\n")] = 0;
+        config_msg(c, "retain", "file", err, n, "%s is in use by another plcrt (pid %s): two would overwrite each "
+                   "other's generations; give each its own [retain] file", c->retain_file, pid[0] ? pid : "?");
+        close(fd);
+        return -1;
+    }
+    if (ftruncate(fd, 0) == 0) dprintf(fd, "%d\n", (int)getpid());
+    return 0;                        /* fd stays open, and locked, until the end */
+}
+
+static const char *sig_name(int sig)
+{
+    switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP (the terminal closed)";
+    case SIGQUIT: return "SIGQUIT";
+    default: return "a signal";
+    }
+}
+
+/* A stop signal already pending (taken), or 0. */
+static int stop_pending(const sigset_t *sigs)
+{
+    sigset_t p;
+    if (sigpending(&p)) return 0;
+    static const int stops[] = { SIGINT, SIGTERM, SIGHUP, SIGQUIT };
+    for (size_t i = 0; i < sizeof stops / sizeof stops[0]; i++)
+        if (sigismember(&p, stops[i])) {
+            struct timespec zero = { 0, 0 };
+            sigtimedwait(sigs, NULL, &zero);
+            return stops[i];
+        }
+    return 0;
+}
+
+/* The program has not returned within [scan] watchdog_ms (an endless loop,
+** say): the scan no longer touches the I/O (scan_watchdog), so the outputs
+** are put in their safe state from here, and plcrt ends with status 3. The
+** scan thread is stuck in the program: it cannot hand over a consistent
+** copy of the retained variables, so the retain file keeps the last
+** generation saved. */
+static _Noreturn void watchdog_halt(scan *sc, mb_server *srv, plc_config *cfg)
+{
+    double ms = (double)(scan_now_ns() - atomic_load(&sc->program_ns)) / 1e6;
+    plc_log(LOG_ERROR, "watchdog: the program has been running for %.0f ms in one cycle, beyond [scan] watchdog_ms "
+            "= %d (an endless loop? a loop bound from a variable?): outputs to their safe state, plcrt stops",
+            ms, cfg->watchdog_ms);
+    mb_server_stop(srv);
+    memset(plc_img.qx, 0, sizeof plc_img.qx);
+    memset(plc_img.qb, 0, sizeof plc_img.qb);
+    memset(plc_img.qw, 0, sizeof plc_img.qw);
+    memset(plc_img.qd, 0, sizeof plc_img.qd);
+    memset(plc_img.ql, 0, sizeof plc_img.ql);
+    cfg->io->safe_state(cfg->io_state, &plc_img);
+    if (!cfg->retain_file[0])
+        fprintf(stderr, "plcrt: stopped by the watchdog: outputs safe (DAC 0 V), nothing retained\n");
+    else
+        fprintf(stderr, "plcrt: stopped by the watchdog: outputs safe (DAC 0 V), retain NOT saved: %s keeps "
+                "the generation saved last\n", cfg->retain_file);
+    fflush(stdout);
+    fflush(stderr);
+    _exit(3);
+}
+
 int main(int argc, char **argv)
 {
     static const struct option opts[] = {
@@ -209,6 +292,11 @@ int main(int argc, char **argv)
         }
     }
     if (optind < argc) { fprintf(stderr, "plcrt: unexpected argument '%s'\n", argv[optind]); usage(stderr); return 2; }
+    if (file && !*file) {            /* plcrt -c "$CFG" with CFG unset */
+        fprintf(stderr, "plcrt: -c needs the name of a configuration file (an empty name was given; "
+                "leave -c out for the defaults)\n");
+        return 2;
+    }
 
     static plc_config cfg;
     const plc_program *prog = &plc_program_linked;
@@ -223,27 +311,55 @@ int main(int argc, char **argv)
         return 0;
     }
 
+    /* From here on a stop signal is taken by the housekeeping loop (or the
+    ** check before the first cycle below), never by its default action: the
+    ** backend may hold outputs from its open on, and they go to their safe
+    ** state on every way out. SIGHUP (the terminal closed) and SIGQUIT
+    ** (Ctrl-backslash) stop the way SIGTERM does, unless plcrt was started
+    ** with them ignored (nohup): blocked, they would be queued and taken. */
+    sigset_t sigs;
+    sigemptyset(&sigs);
+    sigaddset(&sigs, SIGINT); sigaddset(&sigs, SIGTERM);
+    sigaddset(&sigs, SIGUSR1); sigaddset(&sigs, SIGPIPE);
+    static const int optional[] = { SIGHUP, SIGQUIT };
+    for (size_t i = 0; i < sizeof optional / sizeof optional[0]; i++) {
+        struct sigaction sa;
+        if (sigaction(optional[i], NULL, &sa) == 0 && sa.sa_handler != SIG_IGN) sigaddset(&sigs, optional[i]);
+    }
+    pthread_sigmask(SIG_BLOCK, &sigs, NULL);
+
     /* retain */
     retained ret = {0};
     if (retained_setup(&ret, prog)) { fprintf(stderr, "plcrt: out of memory\n"); return 1; }
+    if (cfg.retain_file[0] && ret.n && retain_lock(&cfg, err, sizeof err)) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        return 2;
+    }
     if (cfg.retain_file[0] && ret.n) {
         scan_sample_now(NULL, ret.smp, ret.n, 0, 0);     /* initial values as default */
         if (!retain_load(cfg.retain_file, ret.rv, ret.n, &ret.gen))
             scan_sample_now(NULL, ret.back, ret.n, 0, 0);
     }
 
-    /* I/O */
-    if (cfg.io->open(cfg.io_state, &plc_img, period, err, sizeof err)) {
-        fprintf(stderr, "plcrt: %s: backend %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", cfg.backend, err);
+    /* the Modbus port before any I/O: a second plcrt started on the same
+    ** configuration stops here, before its backend could reset the nodes
+    ** the first one drives */
+    mb_server *srv = NULL;
+    if (mb && !(srv = mb_server_listen(&cfg, mb, err, sizeof err))) {
+        int e = errno;
+        char msg[800];
+        config_msg(&cfg, "modbus", e == EADDRINUSE || e == EACCES ? "port" : "bind", msg, sizeof msg, "%s%s", err,
+                   e == EADDRINUSE ? " (another plcrt running on this configuration? nothing was opened)" : "");
+        fprintf(stderr, "plcrt: %s\n", msg);
         return 2;
     }
 
-    /* signals: handled by this thread only */
-    sigset_t sigs;
-    sigemptyset(&sigs);
-    sigaddset(&sigs, SIGINT); sigaddset(&sigs, SIGTERM); sigaddset(&sigs, SIGUSR1);
-    sigaddset(&sigs, SIGPIPE);
-    pthread_sigmask(SIG_BLOCK, &sigs, NULL);
+    /* I/O */
+    if (cfg.io->open(cfg.io_state, &plc_img, period, err, sizeof err)) {
+        fprintf(stderr, "plcrt: %s: backend %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", cfg.backend, err);
+        mb_server_stop(srv);
+        return 2;
+    }
 
     static scan sc;
     sc.prog = prog; sc.io = cfg.io; sc.io_state = cfg.io_state; sc.mb = mb;
@@ -274,15 +390,24 @@ int main(int argc, char **argv)
         mb_publish(mb, &plc_img, diag);
     }
 
-    mb_server *srv = NULL;
-    if (mb && !(srv = mb_server_start(&cfg, mb, err, sizeof err))) {
-        /* found only now: the port taken since the check, for instance */
-        int e = errno;
-        char msg[800];
-        config_msg(&cfg, "modbus", e == EADDRINUSE || e == EACCES ? "port" : "bind", msg, sizeof msg, "%s", err);
-        fprintf(stderr, "plcrt: %s\n", msg);
+    /* a stop asked for during the start-up: no cycle runs at all, and no
+    ** client has been told a write was taken (nothing served yet: from
+    ** mb_server_run on, a stop takes the orderly way, writes landed) */
+    int early = stop_pending(&sigs);
+    if (early) {
+        mb_server_stop(srv);
+        cfg.io->safe_state(cfg.io_state, &plc_img);
         cfg.io->close(cfg.io_state);
-        return 2;
+        fprintf(stderr, "plcrt: %s during the start-up: stopped before the first cycle, outputs safe (DAC 0 V), "
+                "retain file untouched\n", sig_name(early));
+        return 0;
+    }
+    if (srv && mb_server_run(srv, err, sizeof err)) {
+        fprintf(stderr, "plcrt: %s\n", err);
+        mb_server_stop(srv);
+        cfg.io->safe_state(cfg.io_state, &plc_img);
+        cfg.io->close(cfg.io_state);
+        return 1;
     }
 
     if (cfg.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE))
@@ -326,11 +451,17 @@ int main(int argc, char **argv)
     scan_sample ss[CFG_MAX_STATUS];
     for (int i = 0; i < cfg.nstatus; i++)
         ss[i] = (scan_sample){ plc_var_addr(status[i]), sbuf[i], status[i]->size <= 64 ? status[i]->size : 64 };
+    /* the watchdog looks a few times within its time */
+    long wd_ns = cfg.watchdog_ms ? (long)cfg.watchdog_ms * 1000000 / 4 : 200000000;
+    if (wd_ns > 200000000) wd_ns = 200000000;
+    if (wd_ns < 10000000) wd_ns = 10000000;
     for (;;) {
-        struct timespec to = { 0, 200000000 };
+        struct timespec to = { 0, wd_ns };
         int sig = sigtimedwait(&sigs, NULL, &to);
-        if (sig == SIGINT || sig == SIGTERM) {
-            if (sig == SIGTERM) plc_log(LOG_INFO, "SIGTERM: stopping");
+        if (scan_watchdog(&sc, (uint64_t)cfg.watchdog_ms * 1000000u))
+            watchdog_halt(&sc, srv, &cfg);
+        if (sig == SIGINT || sig == SIGTERM || sig == SIGHUP || sig == SIGQUIT) {
+            if (sig != SIGINT) plc_log(LOG_INFO, "%s: stopping", sig_name(sig));
             else if (isatty(2)) fputc('\n', stderr);   /* past the terminal's ^C */
             stop_sig = sig;
             break;

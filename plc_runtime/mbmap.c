@@ -1,4 +1,5 @@
 /* mbmap.c: see mbmap.h and docs/modbus.md. */
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -155,6 +156,38 @@ static size_t read_regs(mb_shared *m, int table, unsigned a, unsigned n, uint8_t
     return 2 + 2 * n;
 }
 
+/* 1 when writing vals at [a, a+n) would leave a REAL or LREAL symbol nan
+** or infinite (exception 03): the value would run through the program into
+** the outputs. Whole values are judged as the request leaves them (the
+** exponent is in the most significant register, so one register alone
+** decides it as well). */
+static int not_finite(mb_shared *m, unsigned a, unsigned n, const uint8_t *vals)
+{
+    for (unsigned i = 0; i < n;) {
+        cell c;
+        resolve(m, MB_HOLDING, a + i, &c);
+        if (!(c.target & MB_REC_ITEM) || !m->items[c.target & ~MB_REC_ITEM].is_float) { i++; continue; }
+        uint64_t x = plc_load(c.p, c.size);
+        unsigned k = i;
+        for (; k < n && c.w + (k - i) < c.nwords; k++) {
+            unsigned sh = 16 * (c.nwords - 1 - (c.w + (k - i)));
+            x = (x & ~((uint64_t)0xffff << sh)) | ((uint64_t)u16(vals + 2 * k) << sh);
+        }
+        if (c.size == 4) {
+            uint32_t u = (uint32_t)x;
+            float f;
+            memcpy(&f, &u, 4);
+            if (!isfinite(f)) return 1;
+        } else {
+            double d;
+            memcpy(&d, &x, 8);
+            if (!isfinite(d)) return 1;
+        }
+        i = k;
+    }
+    return 0;
+}
+
 static void write_regs(mb_shared *m, unsigned a, unsigned n, const uint8_t *vals)
 {
     for (unsigned i = 0; i < n; i++) {
@@ -212,6 +245,7 @@ static size_t serve(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
     }
     case 6: {
         if ((e = check(m, MB_HOLDING, a, 1, 1))) return exc(m, rsp, fc, e);
+        if (not_finite(m, a, 1, q + 3)) return exc(m, rsp, fc, EX_VALUE);
         write_regs(m, a, 1, q + 3);
         memcpy(rsp, q, 5);
         return 5;
@@ -228,6 +262,7 @@ static size_t serve(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
     }
     case 16: {
         if ((e = check(m, MB_HOLDING, a, cnt, 1))) return exc(m, rsp, fc, e);
+        if (not_finite(m, a, cnt, q + 6)) return exc(m, rsp, fc, EX_VALUE);
         write_regs(m, a, cnt, q + 6);
         memcpy(rsp, q, 5);
         return 5;
@@ -236,6 +271,7 @@ static size_t serve(mb_shared *m, const uint8_t *q, size_t n, uint8_t *rsp)
         unsigned wa = u16(q + 5), wn = u16(q + 7);
         if ((e = check(m, MB_HOLDING, wa, wn, 1)) || (e = check(m, MB_HOLDING, a, cnt, 0)))
             return exc(m, rsp, fc, e);
+        if (not_finite(m, wa, wn, q + 10)) return exc(m, rsp, fc, EX_VALUE);
         write_regs(m, wa, wn, q + 10);        /* the write comes first */
         return read_regs(m, MB_HOLDING, a, cnt, rsp);
     }
@@ -410,6 +446,7 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
             if (!strcasecmp(v->type, types[t].name)) size = types[t].size;
         if (!size) FAIL("type %s cannot be mapped (elementary types only)", v->type);
         it->is_bool = !strcasecmp(v->type, "BOOL");
+        it->is_float = !strcasecmp(v->type, "REAL") || !strcasecmp(v->type, "LREAL");
         if ((y->table == MB_COILS || y->table == MB_DISCRETE) && !it->is_bool)
             FAIL("a %s holds a BOOL, not a %s", tabs[y->table], v->type);
         it->path = v->path;

@@ -61,6 +61,7 @@ typedef struct mb_item {           /* a program variable from the symbol map */
     int table, writable;
     unsigned addr, nregs, size;
     int is_bool;
+    int is_float;                  /* REAL or LREAL: nan and infinities refused */
     void *var;                     /* the value in the program */
 } mb_item;
 

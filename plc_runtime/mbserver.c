@@ -37,8 +37,11 @@ struct mb_server {
     mb_shared *m;
     modbus_t *listen_ctx;
     int lfd, wake, max, n;
+    char bind[64];
+    int port;
     uint64_t idle_ns, listen_pause, seq;
     pthread_t th;
+    int running;                     /* the thread started (mb_server_run) */
     _Atomic int stop;
     client *cl;                      /* n in use, packed */
     struct pollfd *pf;               /* wake, listener, clients */
@@ -205,7 +208,18 @@ static void *server_thread(void *arg)
     return NULL;
 }
 
-mb_server *mb_server_start(const plc_config *c, mb_shared *m, char *err, size_t errlen)
+int mb_server_run(mb_server *s, char *err, size_t errlen)
+{
+    if (pthread_create(&s->th, NULL, server_thread, s)) {
+        snprintf(err, errlen, "cannot start the Modbus thread");
+        return -1;
+    }
+    s->running = 1;
+    plc_log(LOG_INFO, "modbus: listening on %s:%d (at most %d clients)", s->bind, s->port, s->max);
+    return 0;
+}
+
+mb_server *mb_server_listen(const plc_config *c, mb_shared *m, char *err, size_t errlen)
 {
     mb_server *s = calloc(1, sizeof *s);
     if (!s || !(s->cl = calloc((size_t)c->mb_max_clients, sizeof *s->cl))
@@ -217,6 +231,8 @@ mb_server *mb_server_start(const plc_config *c, mb_shared *m, char *err, size_t 
     }
     s->m = m;
     s->max = c->mb_max_clients;
+    snprintf(s->bind, sizeof s->bind, "%s", c->mb_bind);
+    s->port = c->mb_port;
     s->idle_ns = (uint64_t)c->mb_idle_timeout * 1000 * MS;
     s->wake = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
     s->listen_ctx = modbus_new_tcp(c->mb_bind, c->mb_port);
@@ -225,12 +241,6 @@ mb_server *mb_server_start(const plc_config *c, mb_shared *m, char *err, size_t 
         goto fail;
     }
     fcntl(s->lfd, F_SETFL, fcntl(s->lfd, F_GETFL) | O_NONBLOCK);
-    if (pthread_create(&s->th, NULL, server_thread, s)) {
-        snprintf(err, errlen, "cannot start the Modbus thread");
-        close(s->lfd);
-        goto fail;
-    }
-    plc_log(LOG_INFO, "modbus: listening on %s:%d (at most %d clients)", c->mb_bind, c->mb_port, s->max);
     return s;
 fail:
     if (s->wake >= 0) close(s->wake);
@@ -247,7 +257,7 @@ void mb_server_stop(mb_server *s)
     atomic_store(&s->stop, 1);
     uint64_t one = 1;
     if (write(s->wake, &one, sizeof one) < 0) { /* the poll times out anyway */ }
-    pthread_join(s->th, NULL);
+    if (s->running) pthread_join(s->th, NULL);
     close(s->lfd);
     while (s->n) drop(s, s->n - 1, NULL);
     close(s->wake);

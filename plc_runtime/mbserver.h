@@ -17,9 +17,13 @@
 
 typedef struct mb_server mb_server;
 
-/* Listen on the configured address; NULL with a message in err. */
-mb_server *mb_server_start(const plc_config *c, mb_shared *m, char *err, size_t errlen);
-/* Stop serving (a request being served gets its reply first), close every
+/* Take the configured address and port (so that a second plcrt on the
+** same port stops before it touches any I/O); NULL with a message in err.
+** Nothing is served before mb_server_run: connections wait in the queue. */
+mb_server *mb_server_listen(const plc_config *c, mb_shared *m, char *err, size_t errlen);
+/* Start serving (the server's thread). 0, or -1 with a message in err. */
+int mb_server_run(mb_server *s, char *err, size_t errlen);
+/* Stop serving (also before mb_server_run) (a request being served gets its reply first), close every
 ** client, join the thread: no write is taken after it returns. */
 void mb_server_stop(mb_server *s);
 

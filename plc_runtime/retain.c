@@ -138,30 +138,63 @@ int retain_load_file(const char *file, retain_var *v, size_t n, uint64_t *gen,
     else if (memcpy(&crc, p + len - 4, 4), crc != retain_crc32(p, len - 4)) {
         snprintf(err, errlen, "%s: damaged (checksum mismatch)", file); bad = 1;
     }
-    /* parse twice: check everything, then copy */
+    /* parse twice: check everything (and whether the file is this
+    ** program's at all), then copy */
+    uint32_t cnt = 0, known = 0, gone = 0;
+    char first_gone[1024] = "";
     for (int pass = 0; !bad && pass < 2; pass++) {
         rd r = { p, len - 4, 8 };
-        uint32_t cnt;
         if (get(&r, gen, 8) || get(&r, &cnt, 4)) { bad = 1; break; }
         for (uint32_t i = 0; i < cnt && !bad; i++) {
             char path[1024], type[64];
             uint32_t size;
             if (get_str(&r, path, sizeof path) || get_str(&r, type, sizeof type)
                 || get(&r, &size, 4) || r.n - r.at < size) { bad = 1; break; }
-            for (size_t k = 0; pass == 1 && k < n; k++) {
+            int found = 0;
+            for (size_t k = 0; k < n; k++) {
                 if (strcmp(v[k].path, path)) continue;
+                found = 1;
+                if (pass == 0) continue;
                 if (strcmp(v[k].type, type) || v[k].size != size)
                     plc_log(LOG_WARN, "%s: %s was %s, is now %s: keeps its initial value",
                             file, path, type, v[k].type);
                 else memcpy(v[k].data, r.p + r.at, size);
             }
+            if (pass == 0 && found) known++;
+            if (pass == 0 && !found && !gone++) snprintf(first_gone, sizeof first_gone, "%s", path);
             r.at += size;
         }
         if (!bad && r.at != r.n) bad = 1;
         if (bad) snprintf(err, errlen, "%s: damaged (inconsistent records)", file);
+        /* another program's file: nothing of it would be loaded, and the
+        ** next saves would overwrite it and its previous generation */
+        if (!bad && pass == 0 && cnt && !known && n) {
+            snprintf(err, errlen, "%s holds %u retained values, none of a variable of this program "
+                     "(the first: %s): another program's file?", file, cnt, first_gone);
+            free(p);
+            return 2;
+        }
     }
+    if (!bad && gone)
+        plc_log(LOG_WARN, "%s: %u retained value(s) belong to no retained variable of the program any more "
+                "(the first: %s): dropped at the next save", file, gone, first_gone);
     free(p);
     return bad ? -1 : 0;
+}
+
+/* An intact file of another program: renamed FILE.foreign (a numbered name
+** if that is taken), never loaded nor overwritten. */
+static void set_aside(const char *file, const char *why)
+{
+    char to[4300];
+    snprintf(to, sizeof to, "%s.foreign", file);
+    for (int i = 1; i < 100 && access(to, F_OK) == 0; i++) snprintf(to, sizeof to, "%s.foreign%d", file, i);
+    if (rename(file, to)) {
+        plc_log(LOG_ERROR, "retain: %s; not loaded, and it cannot be moved to %s (%s): move it away before "
+                "the next save overwrites it", why, to, strerror(errno));
+        return;
+    }
+    plc_log(LOG_ERROR, "retain: %s; not loaded, kept as %s (give that program its own [retain] file)", why, to);
 }
 
 int retain_load(const char *file, retain_var *v, size_t n, uint64_t *gen)
@@ -170,6 +203,12 @@ int retain_load(const char *file, retain_var *v, size_t n, uint64_t *gen)
     snprintf(prev, sizeof prev, "%s.prev", file);
     int r = retain_load_file(file, v, n, gen, err, sizeof err);
     if (r == 0) { plc_log(LOG_INFO, "retain: loaded %s (generation %llu)", file, (unsigned long long)*gen); return 0; }
+    int foreign = r == 2;
+    if (r == 2) {
+        /* kept out of the way of the saves, whole, for whoever owns it */
+        set_aside(file, err);
+        r = 1;
+    }
     if (r < 0) {
         /* set the damaged file aside, so that the next save cannot make it
         ** the previous generation */
@@ -179,13 +218,18 @@ int retain_load(const char *file, retain_var *v, size_t n, uint64_t *gen)
         rename(file, bad);
     }
     int q = retain_load_file(prev, v, n, gen, err, sizeof err);
+    if (q == 2) {
+        set_aside(prev, err);
+        foreign = 1;
+        q = 1;
+    }
     if (q == 0) {
         plc_log(LOG_WARN, "retain: loaded the previous generation %s (generation %llu)", prev, (unsigned long long)*gen);
-        if (r < 0 && link(prev, file)) plc_log(LOG_WARN, "retain: cannot restore %s: %s", file, strerror(errno));
+        if ((r < 0 || foreign) && link(prev, file)) plc_log(LOG_WARN, "retain: cannot restore %s: %s", file, strerror(errno));
         return 0;
     }
     if (q < 0) plc_log(LOG_ERROR, "retain: %s; not loaded", err);
-    if (r == 1 && q == 1) plc_log(LOG_INFO, "retain: no file %s yet: initial values", file);
+    if (r == 1 && q == 1 && !foreign) plc_log(LOG_INFO, "retain: no file %s yet: initial values", file);
     else plc_log(LOG_WARN, "retain: no usable retain file: retained variables keep their initial values");
     return 1;
 }

@@ -26,12 +26,16 @@ int retain_save(const char *file, const retain_var *v, size_t n, uint64_t gen,
 
 /* Load one file into v[] (variables whose path, type and size match; the
 ** others keep their data). 0 loaded, 1 no such file, -1 damaged (message
-** in err; v[] untouched). *gen gets the generation. */
+** in err; v[] untouched), 2 intact but none of its values belongs to a
+** variable of v[] (another program's file; message in err; v[]
+** untouched). *gen gets the generation. */
 int retain_load_file(const char *file, retain_var *v, size_t n, uint64_t *gen,
                      char *err, size_t errlen);
 
 /* FILE, else FILE.prev. Reports through plc_log. 0 loaded (gen set),
-** 1 nothing usable (v[] untouched). */
+** 1 nothing usable (v[] untouched). A damaged file is moved to FILE.bad,
+** another program's to FILE.foreign (or .prev.foreign), out of the way of
+** the saves that follow. */
 int retain_load(const char *file, retain_var *v, size_t n, uint64_t *gen);
 
 uint32_t retain_crc32(const void *p, size_t n);

@@ -118,7 +118,13 @@ __attribute__((noinline)) void scan_cycle(scan *s, uint64_t plc_ns, unsigned lon
     uint64_t ns = (uint64_t)s->base_nsec + plc_ns % 1000000000u;
     p->now->tv_sec = s->base_sec + (long)(plc_ns / 1000000000u) + (long)(ns / 1000000000u);
     p->now->tv_nsec = (long)(ns % 1000000000u);
+    atomic_store_explicit(&s->program_ns, scan_now_ns(), memory_order_relaxed);
+    atomic_store(&s->phase, SCAN_IN_PROGRAM);
     p->run(tick);
+    if (atomic_exchange(&s->phase, SCAN_OUTSIDE) == SCAN_HALTED) {
+        atomic_store(&s->phase, SCAN_HALTED);       /* the watchdog holds the outputs */
+        return;
+    }
     if (s->force) force_apply(s->force, FORCE_AFTER_PROGRAM);
     if (s->trace) trace_cycle(s->trace, (uint32_t)LD(s->stats.cycles), (uint32_t)tick);
     take_samples(s);
@@ -135,6 +141,14 @@ __attribute__((noinline)) void scan_cycle(scan *s, uint64_t plc_ns, unsigned lon
         atomic_fetch_add_explicit(&s->stats.io_errors, 1, memory_order_relaxed);
 }
 
+int scan_watchdog(scan *s, uint64_t limit_ns)
+{
+    if (!limit_ns || atomic_load(&s->phase) != SCAN_IN_PROGRAM) return 0;
+    if (scan_now_ns() - atomic_load_explicit(&s->program_ns, memory_order_relaxed) < limit_ns) return 0;
+    int in = SCAN_IN_PROGRAM;
+    return atomic_compare_exchange_strong(&s->phase, &in, SCAN_HALTED);
+}
+
 void *scan_thread(void *arg)
 {
     scan *s = arg;
@@ -145,6 +159,7 @@ void *scan_thread(void *arg)
         sleep_until(next);
         uint64_t wake = scan_now_ns();
         scan_cycle(s, next - start, (unsigned long)k);
+        if (atomic_load(&s->phase) == SCAN_HALTED) break;
         uint64_t end = scan_now_ns();
         stat_add(&s->stats.lat, wake > next ? wake - next : 0);
         stat_add(&s->stats.exec, end - wake);

@@ -36,6 +36,10 @@ typedef struct scan {
     _Atomic uint64_t exec_p99_ns, lat_p99_ns;   /* set by housekeeping */
     _Atomic uint64_t retain_saves, retain_errors;
     _Atomic int stop;
+    /* the watchdog (scan_watchdog): SCAN_IN_PROGRAM while the program runs,
+    ** since program_ns; SCAN_HALTED once the watchdog took the outputs */
+    _Atomic int phase;
+    _Atomic uint64_t program_ns;
     /* copies of variables taken by the scan between two cycles */
     _Atomic int sample_req;        /* 0 idle, 1 asked, 2 done */
     const scan_sample *samples;
@@ -43,7 +47,15 @@ typedef struct scan {
     uint64_t started_ns;
 } scan;
 
+enum { SCAN_OUTSIDE = 0, SCAN_IN_PROGRAM = 1, SCAN_HALTED = 2 };
+
 void *scan_thread(void *arg);
+/* Housekeeping: 1 when the program has been running for limit_ns or more
+** in one cycle (an endless loop, say); from then on the scan never touches
+** the I/O, the image's publication or the Modbus exchange again, so that
+** the caller owns the outputs. 0 otherwise (also once the program returned:
+** the scan and the watchdog never both hold the outputs). */
+int scan_watchdog(scan *s, uint64_t limit_ns);
 /* One cycle: inputs, Modbus writes, program, publish, outputs. */
 void scan_cycle(scan *s, uint64_t plc_ns, unsigned long tick);
 uint64_t scan_now_ns(void);

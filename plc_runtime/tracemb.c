@@ -1,4 +1,5 @@
 /* tracemb.c: see tracemb.h and docs/trace.md. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -266,7 +267,13 @@ static int cmd_force(tracemb *b, unsigned cmd, const uint16_t *a, unsigned n)
     }
     uint64_t raw = 0;
     for (int i = 0; i < 4; i++) raw = raw << 16 | a[2 + i];
-    if (trace_type(v) == TT_NONE) return EX_VALUE;
+    int tt = trace_type(v);
+    if (tt == TT_NONE) return EX_VALUE;
+    /* a BOOL other than 0/1 is TRUE and NOT TRUE at once (NOT 2 = 253), and
+    ** a nan or an infinity runs through every computation into the outputs
+    ** (a DAC): neither is a value a program can be given */
+    if (tt == TT_BOOL && raw > 1) return EX_VALUE;
+    if ((tt == TT_REAL || tt == TT_LREAL) && !isfinite(trace_number(raw, tt))) return EX_VALUE;
     if (force_set(b->f, var, raw)) return EX_BUSY;        /* the table full */
     char val[32];
     snprintf(val, sizeof val, "%.17g", trace_number(raw, trace_type(v)));

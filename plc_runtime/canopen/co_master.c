@@ -324,12 +324,22 @@ void co_master_rx(co_master *m, const co_frame *f, co_time now)
         co_emcy e;
         if (!co_emcy_decode(f, &e))
             emcy(m, n, &e);
+        else                        /* too short for an error code: still news */
+            logf_(m, 1, "node %u: EMCY frame of %u byte(s), 8 expected: no error code to report (the node "
+                  "signals an emergency it does not describe, or sends on 0x%03X what is no EMCY)",
+                  n->cfg.id, (unsigned)f->len, (unsigned)f->id);
     } else if (fc >= CO_FC_TPDO1 && fc < CO_FC_TPDO1 + 0x100 * CO_PDO_PER_NODE && (fc & 0x80)) {
         unsigned k = (fc - CO_FC_TPDO1) / 0x100;
-        if (n->phase == CO_PH_RUN && f->len >= (co_pdo_bits(&n->cfg.tpdo[k]) + 7) / 8) {
+        unsigned need = (co_pdo_bits(&n->cfg.tpdo[k]) + 7) / 8;
+        if (n->phase == CO_PH_RUN && f->len >= need) {
             memcpy(n->rx[k], f->data, f->len);
             n->rx_new |= (uint8_t)(1 << k);
             n->rx_pdos++;
+        } else if (n->phase == CO_PH_RUN && n->short_pdos++ % 1000 == 0) {
+            /* its inputs keep their last values: never silently */
+            logf_(m, 1, "node %u: TPDO%u of %u byte(s), its mapping needs %u: ignored, the inputs it carries keep "
+                  "their last values (%u such so far; the node's mapping 0x%04X differs from the configuration's "
+                  "tpdo%u)", n->cfg.id, k + 1, (unsigned)f->len, need, (unsigned)n->short_pdos, 0x1A00 + k, k + 1);
         }
     }
 }

@@ -61,6 +61,7 @@ typedef struct co_node {
     uint32_t starts, unexpected_boot, hb_lost, emcy_count, sdo_errors;
     uint32_t last_abort;
     uint32_t rx_pdos, tx_pdos;
+    uint32_t short_pdos;            /* TPDOs shorter than their mapping: ignored, reported */
     co_emcy last_emcy;
 } co_node;
 

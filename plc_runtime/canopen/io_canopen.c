@@ -138,7 +138,10 @@ static int num(const char *v, unsigned long max, unsigned long *out, char *err, 
 {
     char *end;
     errno = 0;
-    unsigned long x = strtoul(v, &end, 0);
+    /* decimal, or hexadecimal with 0x: never octal, so that id = 010 is
+    ** node 10 (as every other integer of the file), not node 8 */
+    int hex = v[0] == '0' && (v[1] == 'x' || v[1] == 'X');
+    unsigned long x = strtoul(v, &end, hex ? 16 : 10);
     while (*end == ' ' || *end == '\t')
         end++;
     if (errno || end == v || *end || *v == '-' || x > max) {
@@ -410,6 +413,57 @@ static void poll_bus(st *s)
     co_master_tick(&s->m, now);
 }
 
+static void loc_text(const plc_loc *l, char *out, size_t n)
+{
+    if (l->size == 'X')
+        snprintf(out, n, "%%%cX%u.%u", l->area, l->index, l->bit);
+    else
+        snprintf(out, n, "%%%c%c%u", l->area, l->size, l->index);
+}
+
+/* Every input the master writes into the image (bind to an %I location,
+** status, ok) in a place of its own: two nodes bound to one input (a
+** section copied and not edited) would leave the program the second one's
+** values only, without a word. (Outputs may repeat: one %Q driving two
+** objects.) 0, or -1 naming both. */
+static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
+{
+    struct { const uint8_t *p; unsigned w; char who[96]; } in[MAX_BINDS + 2 * MAX_NODES];
+    int k = 0;
+    char t[32];
+    for (int i = 0; i < s->nbinds; i++) {
+        const bind *b = &s->binds[i];
+        if (b->loc.area != 'I')
+            continue;
+        loc_text(&b->loc, t, sizeof t);
+        in[k].p = plc_loc_ptr(img, &b->loc);
+        in[k].w = plc_loc_width(&b->loc);
+        if (b->bit >= 0)
+            snprintf(in[k++].who, sizeof in[0].who, "[%.40s] bind 0x%04X:%02X.%d %s", s->ex[b->node].name, b->index,
+                     b->sub, b->bit, t);
+        else
+            snprintf(in[k++].who, sizeof in[0].who, "[%.40s] bind 0x%04X:%02X %s", s->ex[b->node].name, b->index,
+                     b->sub, t);
+    }
+    for (int i = 0; i < s->nnodes; i++)
+        for (int j = 0; j < 2; j++) {
+            const plc_loc *l = j ? &s->ex[i].ok : &s->ex[i].status;
+            if (!(j ? s->ex[i].has_ok : s->ex[i].has_status))
+                continue;
+            loc_text(l, t, sizeof t);
+            in[k].p = plc_loc_ptr(img, l);
+            in[k].w = plc_loc_width(l);
+            snprintf(in[k++].who, sizeof in[0].who, "[%.40s] %s %s", s->ex[i].name, j ? "ok" : "status", t);
+        }
+    for (int i = 0; i < k; i++)
+        for (int j = 0; j < i; j++)
+            if (in[i].p < in[j].p + in[j].w && in[j].p < in[i].p + in[i].w) {
+                snprintf(err, n, "%s and %s write the same input: give each its own address", in[j].who, in[i].who);
+                return -1;
+            }
+    return 0;
+}
+
 static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
 {
     st *s = vs;
@@ -433,6 +487,8 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
     for (int i = 0; i < s->nbinds; i++)
         if (resolve(s, &s->binds[i], err, n))
             return -1;
+    if (inputs_apart(s, img, err, n))
+        return -1;
     s->fd = co_can_open(s->ifname, err, n);
     if (s->fd < 0)
         return -1;

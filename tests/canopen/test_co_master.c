@@ -257,10 +257,18 @@ START_TEST(process_data_and_sync)
     ck_assert_uint_eq(n[0].rx_new, 2);
     ck_assert_int_eq((int16_t)co_bits_get(n[0].rx[1], 0, 16), 10000);
     ck_assert_int_eq(co_bits_sext(co_bits_get(n[0].rx[1], 48, 16), 16), -32768);
-    /* a TPDO shorter than its mapping is ignored */
+    /* a TPDO shorter than its mapping is ignored, and said so once (then
+    ** every 1000th): its inputs would otherwise freeze without a word */
+    logbuf[0] = 0;
     t = frame(0x181, 2, (uint8_t[]){ 1, 2 });
     co_master_rx(&m, &t, T0);
     ck_assert_uint_eq(n[0].rx_new, 2);
+    ck_assert_msg(strstr(logbuf, "E node 1: TPDO1 of 2 byte(s), its mapping needs 8: ignored"), "%s", logbuf);
+    ck_assert_msg(strstr(logbuf, "mapping 0x1A00 differs from the configuration's tpdo1"), "%s", logbuf);
+    logbuf[0] = 0;
+    co_master_rx(&m, &t, T0);
+    ck_assert_str_eq(logbuf, "");
+    ck_assert_uint_eq(n[0].short_pdos, 2);
 }
 END_TEST
 
@@ -355,6 +363,12 @@ START_TEST(emcy_logged_and_flagged)
     co_master_rx(&m, &e, T0);
     ck_assert(!(n[0].fault & CO_F_EMCY));
     ck_assert_uint_eq(n[0].emcy_count, 1);
+    /* an EMCY too short for its error code: ignored before, now said */
+    logbuf[0] = 0;
+    e = frame(0x083, 1, (uint8_t[]){ 0x10 });
+    co_master_rx(&m, &e, T0);
+    ck_assert_msg(strstr(logbuf, "E node 3: EMCY frame of 1 byte(s), 8 expected: no error code to report"), "%s",
+                  logbuf);
     /* bus-off error frame */
     co_frame bo = frame(CO_ERR_FLAG | 0x40, 8, (uint8_t[]){ 0, 0, 0, 0, 0, 0, 0, 0 });
     co_master_rx(&m, &bo, T0);

@@ -575,6 +575,94 @@ START_TEST(robust)
 }
 END_TEST
 
+/* What a careless hand writes into the backends' sections: a key given
+** twice (the second silently won), nan (passed every range check and made
+** the plant nan), two axes writing one counter (each loop followed the
+** other's encoder), a node id with a leading zero (read as octal: id = 010
+** drove node 8). */
+START_TEST(careless_backend)
+{
+    bad("[sim.axis0]\ndac = %QW1\ncounter = %ID1\ndac = %QW2\n",
+        "plant.ini:4: [sim.axis0] dac: given twice (first on line 2)");
+    bad("[sim.axis0]\ndac = %QW1\n[sim.axis1]\ndac = %QW2\n[sim.axis0]\ndac = %QW3\n",
+        "plant.ini:6: [sim.axis0] dac: given twice (first on line 2)");
+    bad("[sim.axis0]\nmaxvel = nan\n", "plant.ini:2: [sim.axis0] maxvel: 'nan' is not a number in 0..1e+09");
+    bad("[sim.axis0]\nlag = NAN\n", "[sim.axis0] lag: 'NAN' is not a number");
+    bad("[sim.axis0]\noffset = -inf\n", "[sim.axis0] offset: '-inf' is not a number");
+    bad("[sim.master]\nspeed = nan\n", "[sim.master] speed: 'nan' is not a number");
+    bad("[sim.marker0]\nnoise = nan\n", "[sim.marker0] noise: 'nan' is not a number");
+
+    const io_backend_ops *o = io_backend_find("sim");
+    static plc_image img;
+    char e[300];
+    void *st = o->create();
+    SET("sim.axis0", "dac", "%QW0"); SET("sim.axis0", "counter", "%ID0");
+    SET("sim.axis1", "dac", "%QW0"); SET("sim.axis1", "counter", "%ID0");
+    ck_assert_int_ne(o->open(st, &img, 0, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[sim.axis0] counter and [sim.axis1] counter write the same input"), "%s", e);
+    o->close(st);
+    st = o->create();               /* a %MD counter over an %MD zero latch of the master */
+    SET("sim.axis0", "dac", "%QW0"); SET("sim.axis0", "counter", "%MD4");
+    SET("sim.master", "counter", "%MD4");
+    ck_assert_int_ne(o->open(st, &img, 0, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[sim.axis0] counter and [sim.master] counter write the same input"), "%s", e);
+    o->close(st);
+    st = o->create();               /* one DAC for two drives, each its own encoder: fine */
+    SET("sim.axis0", "dac", "%QW0"); SET("sim.axis0", "counter", "%ID0");
+    SET("sim.axis1", "dac", "%QW0"); SET("sim.axis1", "counter", "%ID1");
+    ck_assert_msg(o->open(st, &img, 0, e, sizeof e) == 0, "%s", e);
+    o->close(st);
+
+    /* CANopen: checked at open before the bus is opened */
+    o = io_backend_find("canopen");
+    ck_assert_ptr_nonnull(o);
+    st = o->create();
+    ck_assert_msg(o->config(st, "canopen.a", "id", "010", e, sizeof e) == 0, "%s", e);
+    ck_assert_msg(o->config(st, "canopen.b", "id", "10", e, sizeof e) == 0, "%s", e);
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[canopen.a] and [canopen.b] both have id 10"), "%s", e);
+    o->close(st);
+    st = o->create();
+    ck_assert_msg(o->config(st, "canopen.a", "id", "0x0A", e, sizeof e) == 0, "%s", e);
+    ck_assert_msg(o->config(st, "canopen.b", "id", "10", e, sizeof e) == 0, "%s", e);
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "both have id 10"), "%s", e);
+    o->close(st);
+    st = o->create();               /* 09: refused as a bad octal number before */
+    ck_assert_msg(o->config(st, "canopen.a", "id", "09", e, sizeof e) == 0, "%s", e);
+    ck_assert_msg(o->config(st, "canopen.b", "id", "9", e, sizeof e) == 0, "%s", e);
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "both have id 9"), "%s", e);
+    o->close(st);
+    /* two nodes bound to one input: refused before the bus is opened; one
+    ** output driving two objects is fine */
+    st = o->create();
+#define CO(sec, k, v) ck_assert_msg(o->config(st, sec, k, v, e, sizeof e) == 0, "%s %s = %s: %s", sec, k, v, e)
+    CO("canopen.left", "id", "1"); CO("canopen.right", "id", "2");
+    CO("canopen.left", "bind", "0x6000:01 %IB4"); CO("canopen.right", "bind", "0x6000:01 %IB4");
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[canopen.left] bind 0x6000:01 %IB4 and [canopen.right] bind 0x6000:01 %IB4 "
+                            "write the same input"), "%s", e);
+    o->close(st);
+    st = o->create();
+    CO("canopen.left", "id", "1"); CO("canopen.right", "id", "2");
+    CO("canopen.left", "bind", "0x6000:01.3 %IX2.0"); CO("canopen.right", "ok", "%IX2.0");
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(strstr(e, "[canopen.left] bind 0x6000:01.3 %IX2.0 and [canopen.right] ok %IX2.0"), "%s", e);
+    o->close(st);
+    st = o->create();              /* apart, and one %QB to both nodes: on to the bus (none here) */
+    CO("canopen.left", "id", "1"); CO("canopen.right", "id", "2"); CO("canopen", "interface", "nocan9");
+    CO("canopen.left", "bind", "0x6000:01 %IB4"); CO("canopen.right", "bind", "0x6000:01 %IB5");
+    CO("canopen.left", "bind", "0x6200:01 %QB4"); CO("canopen.right", "bind", "0x6200:01 %QB4");
+    ck_assert_int_ne(o->open(st, &img, 1000000, e, sizeof e), 0);
+    ck_assert_msg(!strstr(e, "same input") && strstr(e, "nocan9"), "%s", e);
+    o->close(st);
+#undef CO
+    bad("[io]\nbackend = canopen\n[canopen.a]\nid = 3\nid = 4\n",
+        "plant.ini:5: [canopen.a] id: given twice (first on line 4)");
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("config");
@@ -601,6 +689,7 @@ int main(void)
     tcase_add_test(t, whole);
     tcase_add_test(t, messages);
     tcase_add_test(t, robust);
+    tcase_add_test(t, careless_backend);
     suite_add_tcase(s, t);
     return check_run(s);
 }

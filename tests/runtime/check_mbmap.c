@@ -274,6 +274,32 @@ START_TEST(symbols)
 }
 END_TEST
 
+/* A REAL or LREAL symbol written nan or infinite: exception 03, nothing of
+** the request lands (it would run through the program into the outputs). */
+START_TEST(symbols_finite)
+{
+    uint16_t nan[4] = { 0x7FF8, 0, 0, 0 }, inf[4] = { 0xFFF0, 0, 0, 0 }, two[4] = { 0x4000, 0, 0, 0 };
+
+    write_regs(9010, 4, nan); EXC(16, 3);
+    write_regs(9010, 4, inf); EXC(16, 3);
+    pdu(5, 6, 0x23, 0x32, 0x7F, 0xF0); EXC(6, 3);                /* 9010 alone: +inf whatever follows */
+    uint8_t q23[] = { 23, 0x23, 0x28, 0, 2, 0x23, 0x32, 0, 4, 8, 0x7F, 0xF8, 0, 0, 0, 0, 0, 1 };
+    rn = mb_process(m, q23, sizeof q23, rsp); EXC(23, 3);
+
+    cycle();
+    ck_assert(v_lreal == 0);
+    write_regs(9010, 4, two); OK(16);
+    cycle();
+    ck_assert(v_lreal == 2.0);
+    pdu(5, 6, 0x23, 0x33, 0x12, 0x34); OK(6);                   /* a low word: still finite */
+    cycle();
+    ck_assert(v_lreal == 2.0 * (1.0 + 0x1234 / 1048576.0));     /* 0x40001234 00000000 */
+    /* %MD/%ML have no type: any bits go */
+    uint16_t md[2] = { 0x7FC0, 0 };
+    write_regs(2048, 2, md); OK(16);
+}
+END_TEST
+
 START_TEST(many_writes_between_cycles)
 {
     /* far more writes than cells between two cycles: never busy, last wins */
@@ -378,6 +404,7 @@ int main(void)
     tcase_add_test(t, holding_writes);
     tcase_add_test(t, fc23);
     tcase_add_test(t, symbols);
+    tcase_add_test(t, symbols_finite);
     tcase_add_test(t, many_writes_between_cycles);
     tcase_add_test(t, threads_never_tear);
     tcase_add_test(t, symbol_errors);

@@ -175,6 +175,59 @@ START_TEST(type_changed)
 }
 END_TEST
 
+static void slurp(const char *f, char *out, size_t cap, size_t *n)
+{
+    FILE *fp = fopen(f, "rb");
+    ck_assert_msg(fp != NULL, "%s missing", f);
+    *n = fread(out, 1, cap, fp);
+    fclose(fp);
+}
+
+/* Another program's file given to this one (a copied configuration): it
+** used to be "loaded" (nothing of it matched) and the next two saves wiped
+** it and its previous generation. Now it is reported, kept whole as
+** FILE.foreign, and the saves that follow leave it alone. */
+START_TEST(foreign_file)
+{
+    static int32_t x;
+    static double y;
+    retain_var other[2] = { { "CONFIG0.RES0.PRESS.X", "DINT", &x, sizeof x },
+                            { "CONFIG0.RES0.PRESS.Y", "LREAL", &y, sizeof y } };
+    char err[600], foreign[400], want[4096], got[4096];
+    size_t nwant, ngot;
+    uint64_t g = 0;
+    x = 77; y = 2.5;
+    ck_assert(!retain_save(file, other, 2, 9, err, sizeof err));
+    slurp(file, want, sizeof want, &nwant);
+    fill(1000);
+    ck_assert_int_eq(retain_load_file(file, v, 3, &g, err, sizeof err), 2);
+    ck_assert_msg(strstr(err, "holds 2 retained values, none of a variable of this program (the first: "
+                              "CONFIG0.RES0.PRESS.X): another program's file?"), "%s", err);
+    ck_assert(consistent(1000));
+    ck_assert_int_eq(retain_load(file, v, 3, &g), 1);
+    ck_assert(consistent(1000));                     /* initial values */
+    snprintf(foreign, sizeof foreign, "%s.foreign", file);
+    ck_assert_int_lt(file_size(file), 0);            /* out of the way */
+    save(1);
+    save(2);
+    save(3);
+    slurp(foreign, got, sizeof got, &ngot);
+    ck_assert_uint_eq(ngot, nwant);
+    ck_assert(!memcmp(got, want, nwant));            /* whole, after three saves */
+    x = 0; y = 0;
+    ck_assert_int_eq(retain_load_file(foreign, other, 2, &g, err, sizeof err), 0);
+    ck_assert(x == 77 && y == 2.5 && g == 9);        /* its program can have it back */
+
+    /* a file of this program with a variable since removed: still loaded */
+    retain_var more[4] = { v[0], v[1], v[2], { "CONFIG0.RES0.I.OLD", "INT", &x, 2 } };
+    fill(5);
+    ck_assert(!retain_save(file, more, 4, 5, err, sizeof err));
+    fill(1000);
+    ck_assert_int_eq(retain_load_file(file, v, 3, &g, err, sizeof err), 0);
+    ck_assert(consistent(5));
+}
+END_TEST
+
 /* The child saves generation after generation and reports each completed
 ** one on a pipe; it is killed at a random moment. The file must then hold
 ** the last reported generation or the one being written (complete), and
@@ -245,6 +298,7 @@ int main(void)
     tcase_add_test(t, flipped_byte);
     tcase_add_test(t, previous_generation);
     tcase_add_test(t, type_changed);
+    tcase_add_test(t, foreign_file);
     tcase_add_test(t, kill9_loop);
     suite_add_tcase(s, t);
     return check_run(s);

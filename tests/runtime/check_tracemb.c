@@ -13,12 +13,14 @@
 static int32_t pos;
 static int16_t speed;
 static uint8_t go;
+static float gain;
 static plc_var vars[] = {
     { "CONFIG0.RES0.INST0.POS", "DINT", 0, 0, 4, &pos },
     { "CONFIG0.RES0.INST0.SPEED", "INT", 0, 0, 2, &speed },
     { "CONFIG0.RES0.INST0.GO", "BOOL", 0, 0, 1, &go },
+    { "CONFIG0.RES0.INST0.GAIN", "REAL", 0, 0, 4, &gain },
 };
-static const plc_program prog = { "CONFIG0", NULL, NULL, NULL, NULL, vars, 3 };
+static const plc_program prog = { "CONFIG0", NULL, NULL, NULL, NULL, vars, 4 };
 
 static trace *t;
 static forcing *f;
@@ -107,6 +109,33 @@ START_TEST(capture_through_the_block)
 }
 END_TEST
 
+/* FORCE of var with the 64-bit raw value: 0, or the exception code */
+static int force(uint32_t var, uint64_t raw)
+{
+    uint16_t r[8] = { 0, 17, (uint16_t)(var >> 16), (uint16_t)var,
+                      (uint16_t)(raw >> 48), (uint16_t)(raw >> 32), (uint16_t)(raw >> 16), (uint16_t)raw };
+    return write16(TB_CMD, r, 8);
+}
+
+/* Values no program can be given: a BOOL of 2 (TRUE, and NOT of it TRUE
+** too) and a REAL nan or infinity (through the program into a DAC): 03,
+** and nothing forced; the ordinary values still are. */
+START_TEST(force_values)
+{
+    uint32_t nan32 = 0x7FC00000u, inf32 = 0x7F800000u, minf32 = 0xFF800000u, one32 = 0x3F800000u;
+    ck_assert_int_eq(force(2, 2), 3);
+    ck_assert_int_eq(force(2, 0xFF), 3);
+    ck_assert_int_eq(force(3, nan32), 3);
+    ck_assert_int_eq(force(3, inf32), 3);
+    ck_assert_int_eq(force(3, minf32), 3);
+    ck_assert_int_eq(force_count(f), 0);
+    ck_assert_int_eq(force(2, 1), 0);
+    ck_assert_int_eq(force(3, one32), 0);
+    ck_assert_int_eq(force(1, 0xFFFF), 0);          /* INT -1 */
+    ck_assert_int_eq(force_count(f), 3);
+}
+END_TEST
+
 START_TEST(random_requests)
 {
     srand(12345);
@@ -155,6 +184,7 @@ int main(void)
     tcase_set_timeout(tc, 60);
     tcase_add_test(tc, capture_through_the_block);
     tcase_add_test(tc, random_requests);
+    tcase_add_test(tc, force_values);
     suite_add_tcase(s, tc);
     SRunner *r = srunner_create(s);
     srunner_run_all(r, CK_NORMAL);

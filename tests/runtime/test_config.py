@@ -111,6 +111,11 @@ if a:
 refused("-c FOLDER: an error naming the folder", WORK, f"{WORK}: is a folder, not a configuration file")
 refused("-c FOLDER: the start refuses it too", WORK, f"{WORK}: is a folder", False)
 
+# an empty name (a shell variable left unset: plcrt -c "$CFG")
+refused("-c '': says a file name is missing (was ': No such file or directory')", "",
+        "-c needs the name of a configuration file")
+refused("-c '': the start refuses it too", "", "-c needs the name of a configuration file", False)
+
 # long lines: a valid status_vars line of 234 characters, line numbers after it
 names = ["TICKS", "KEEP_REAL", "QW_ECHO", "IW_FIRST", "QX_LAST", "IX_LAST", "IW_LAST", "KEEP"]
 line = "status_vars = " + ", ".join(VAR + n for n in names)
@@ -162,6 +167,29 @@ with socket.socket() as busy:
     report("a port in use passes --check-config (a running plcrt may hold it)", rc == 0, "" if rc == 0 else out)
     refused("a port in use: the start names [modbus] port, status 2", path,
             f"{path}:4: [modbus] port: cannot listen on 127.0.0.1:{port}", False)
+    # a second plcrt on the port of a running one stops before its backend
+    # opens anything (a CANopen master would reset the nodes the first one
+    # drives): here the CAN interface does not even exist, and the message
+    # is about the port, not about the interface
+    path = write("busy-can.ini", f"[io]\nbackend = canopen\n[modbus]\nport = {port}\n[canopen]\n"
+                 "interface = nocan9\n[canopen.io1]\nid = 5\n[retain]\nfile =\n")
+    rc, out = run(path, False)
+    report("a port in use: refused before the backend is opened (no CAN interface touched)",
+           rc == 2 and f"{path}:4: [modbus] port: cannot listen" in out and "another plcrt" in out
+           and "nocan9" not in out and "backend canopen" not in out, f"status {rc}: {out.strip()[-400:]}")
+
+# two plcrt on one retain file (two ports): the second is refused, naming
+# the first's pid, before it loads or saves anything
+shared = os.path.join(WORK, "shared.retain")
+first = Plcrt(PLCRT, write("shared1.ini", f"[io]\nbackend = none\n[modbus]\nport = {free_port()}\n"
+                                          f"[retain]\nfile = {shared}\n"), WORK, "shared")
+path = write("shared2.ini", f"[io]\nbackend = none\n[modbus]\nport = {free_port()}\n[retain]\nfile = {shared}\n")
+refused("a retain file in use by another plcrt: refused, naming it and its pid", path,
+        f"{path}:6: [retain] file: {shared} is in use by another plcrt (pid {first.p.pid})", False)
+first.stop()
+second = Plcrt(PLCRT, path, WORK, "shared")
+report("once the first stopped, the second starts on the file", second.alive())
+second.stop()
 
 Plcrt.kill_all()
 sys.exit(0 if report.all_passed() else 1)

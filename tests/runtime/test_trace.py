@@ -339,6 +339,49 @@ try:
     report("forcing a variable beyond the table: exception 02; a FORCE of 3 registers: 03",
            cmd(c, 0, FORCE, a32(100000) + [0] * 4) == 2 and cmd(c, 0, FORCE, a32(0) + [0]) == 3)
 
+    # ---- careless values: refused, saying why and what fits, nothing forced ----
+    def pt(*args):
+        return subprocess.run([PLCTRACE, "--port", str(PORT)] + list(args), capture_output=True, text=True,
+                              timeout=60)
+
+    for path, value, want in (("saw", "nan", "'nan' is not a finite number"),
+                              ("saw", "1e40", "'1e40' does not fit a REAL"),
+                              ("gain", "1.5", "'1.5' is not an integer (INT: -32768..32767"),
+                              ("gain", "70000", "'70000' does not fit an INT (-32768..32767)")):
+        r = pt("force", path, value)
+        report(f"plctrace force {path} {value}: refused with a message, no traceback",
+               r.returncode == 1 and want in r.stderr and "Traceback" not in r.stderr, r.stderr[-300:])
+    # the same through the register block: a REAL nan, a BOOL of 2
+    report("FORCE of a REAL nan or a BOOL of 2 through the block: exception 03, nothing forced",
+           cmd(c, 0, FORCE, a32(lookup(c, "saw")) + [0, 0, 0x7FC0, 0]) == 3
+           and cmd(c, 0, FORCE, a32(lookup(c, "toggle")) + [0, 0, 0, 2]) == 3 and diag_forced() == 0,
+           f"forced {diag_forced()}")
+    r = pt("force", "gain", "010")
+    report("plctrace force gain 010: ten, as everywhere in plcrt (not octal 8): scaled 100",
+           r.returncode == 0 and wait_for(lambda: hreg(9000) == 100, 2), f"{r.stderr} scaled {hreg(9000)}")
+    pt("unforce", "--all")
+    # the forcing table full (64): plctrace said "busy: another client owns
+    # the trace"; now it says how many are forced and what to do
+    full = [cmd(c, 0, FORCE, a32(lookup(c, f"spare[{k}]")) + [0, 0, 0, k]) for k in range(1, 65)]
+    r = pt("force", "gain", "3")
+    report("plctrace force with 64 variables forced: says the table is full and how to release one",
+           full == [0] * 64 and r.returncode == 1 and "64 variables are forced, the most plcrt forces at once" in r.stderr
+           and "plctrace unforce PATH" in r.stderr, f"{full.count(0)} forced; {r.stderr[-300:]}")
+    pt("unforce", "--all")
+    missing = os.path.join(WORK, "no-such-folder", "rec.csv")
+    r = pt("record", "--chan", "count", "--samples", "100", "--no-plot", "-o", missing)
+    report("plctrace record -o into a missing folder: refused before the capture (not lost after it)",
+           r.returncode == 1 and "no folder" in r.stderr and "Traceback" not in r.stderr and status(c)[4] == 0,
+           r.stderr[-300:])
+    r = pt("record", "--chan", "count", "--trigger", "count:rise", "--no-plot", "-o", os.path.join(WORK, "x.csv"))
+    report("plctrace record --trigger count:rise (a DINT): says rise takes a BOOL and what to use instead",
+           r.returncode == 1 and "rise and fall take a BOOL" in r.stderr and "count:up:LEVEL" in r.stderr,
+           r.stderr[-300:])
+    r = pt("record", "--chan", "count", "--samples", "999999999", "--no-plot", "-o", os.path.join(WORK, "x.csv"))
+    report("plctrace record --samples beyond the buffer: names the limit and the key that sets it",
+           r.returncode == 1 and f"at most {status(c)[6] << 16 | status(c)[7]} samples" in r.stderr
+           and "[trace] samples" in r.stderr, r.stderr[-300:])
+
     # ---- plctrace record: CSV with the expected columns, and a PNG ----
     csvp = os.path.join(WORK, "rec.csv")
     for f in (csvp, csvp[:-4] + ".png"):

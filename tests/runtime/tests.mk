@@ -114,3 +114,42 @@ test-runtime-trace: $(BUILD)/plc/rt_trace/plcrt
 	@mk/suite.sh $(RESULTS) runtime-trace python3 tests/runtime/test_trace.py \
 	  $(BUILD)/plc/rt_trace/plcrt $(abspath $(RT_T))/trace
 TESTS += test-runtime-trace
+# every stop signal (SIGHUP, SIGQUIT too) the orderly way out, and a stop
+# asked for during the start-up before any cycle (docs/runtime.md)
+.PHONY: test-runtime-signals
+test-runtime-signals: $(BUILD)/plc/rt_iotest/plcrt
+	@mk/suite.sh $(RESULTS) runtime-signals python3 tests/runtime/test_signals.py \
+	  $(BUILD)/plc/rt_iotest/plcrt $(abspath $(RT_T))/signals
+TESTS += test-runtime-signals
+MATIEC_TESTS += test-runtime-signals
+# the watchdog: a program that never returns puts the outputs in their safe
+# state and stops plcrt (status 3); long cycles do not trip it
+.PHONY: test-runtime-watchdog
+test-runtime-watchdog: $(BUILD)/plc/rt_spin/plcrt
+	@mk/suite.sh $(RESULTS) runtime-watchdog python3 tests/runtime/test_watchdog.py \
+	  $(BUILD)/plc/rt_spin/plcrt $(abspath $(RT_T))/watchdog
+TESTS += test-runtime-watchdog
+# fuzzing what plcrt takes from outside while it runs (tests/fuzz/fuzz_plcrt.c):
+# Modbus requests into the map and the trace/forcing block with scan cycles
+# between them, and retain files behind a valid checksum. Briefly in `make
+# test`, longer in `make fuzz` (FUZZ_SECONDS).
+FUZZ_CC ?= clang
+RT_SRC_FUZZ := $(filter %.c,$(RT_SRC_MAP)) $(addprefix plc_runtime/,retain.c trace.c force.c tracemb.c scan.c stats.c)
+$(BUILD)/fuzz/fuzz_plcrt: tests/fuzz/fuzz_plcrt.c $(RT_SRC_FUZZ) $(CO_BACKEND) $(PLCRT_HDRS)
+	@mkdir -p $(dir $@)
+	$(call say,CC,$@ (libFuzzer))
+	$(Q)$(FUZZ_CC) -g -O1 -std=c11 -D_DEFAULT_SOURCE -D_GNU_SOURCE -I plc_runtime \
+	  $(shell pkg-config --cflags libmodbus 2>/dev/null) -fsanitize=fuzzer,address,undefined \
+	  -o $@ tests/fuzz/fuzz_plcrt.c $(RT_SRC_FUZZ) $(CO_BACKEND) $(PLCRT_LIBS)
+RT_FUZZ_RUN = mkdir -p $(BUILD)/fuzz/corpus_plcrt && ASAN_OPTIONS=detect_leaks=0 $(BUILD)/fuzz/fuzz_plcrt \
+	-rss_limit_mb=2048 -timeout=5 -max_len=2048 -artifact_prefix=$(BUILD)/fuzz/plcrt- \
+	$(BUILD)/fuzz/corpus_plcrt tests/fuzz/corpus_plcrt
+.PHONY: test-runtime-fuzz fuzz-plcrt
+test-runtime-fuzz: $(BUILD)/fuzz/fuzz_plcrt
+	@mk/suite.sh $(RESULTS) runtime-fuzz sh -c '$(RT_FUZZ_RUN) -max_total_time=15 > $(BUILD)/fuzz/plcrt.log 2>&1 \
+	    && echo "PASS: plcrt (Modbus requests, trace and forcing, retain files) survives 15 s of fuzzing" \
+	    || { tail -n 30 $(BUILD)/fuzz/plcrt.log; echo "FAIL: plcrt fuzzing found a crash (input in $(BUILD)/fuzz/plcrt-*)"; }'
+TESTS += test-runtime-fuzz
+FUZZES += fuzz-plcrt
+fuzz-plcrt: $(BUILD)/fuzz/fuzz_plcrt
+	$(RT_FUZZ_RUN) -max_total_time=$${FUZZ_SECONDS:-600}
