@@ -421,6 +421,8 @@ def prog_errors():
     p.check(14, "BUILD acts on its rising edge only")
     p.check(15, "fix points so close that the slope overflows (1e10 UU over 1e-300 MU): "
                 "error 12 naming the segment, the curve in use stays")
+    p.check(17, "a start/stop pair with START = STOP, or a whole cycle apart (CAMSYNC would wait "
+                "for START for ever): error 9 naming the pair")
     p.check(16, "MPOS NaN or 1e300 (beyond 1e15 cycles): every output holds its last value, no jump")
     p.fbs.append("cv : CAM_CURVE;")
     p.fbs.append("c : CAMCURVE;")
@@ -476,6 +478,13 @@ def prog_errors():
     p.line("cv.STARTSTOP[2].START := 2500.0; cv.STARTSTOP[2].STOP := 4500.0;")
     build()
     p.ok(8, "c.ERROR AND c.ERRORID = 9 AND c.ERRPOINT = 2", "INT_TO_LREAL(c.ERRPOINT)")
+    p.line("cv.STARTSTOP[2].STOP := 2500.0;")
+    build()
+    p.ok(17, "c.ERROR AND c.ERRORID = 9 AND c.ERRPOINT = 2", "INT_TO_LREAL(c.ERRPOINT)")
+    p.line("cv.STARTSTOP[2].START := 0.0; cv.STARTSTOP[2].STOP := 4000.0;")
+    build()
+    p.ok(17, "c.ERROR AND c.ERRORID = 9 AND c.ERRPOINT = 2", "INT_TO_LREAL(c.ERRPOINT)")
+    p.line("cv.STARTSTOP[2].START := 2500.0;")
     p.line("cv.STARTSTOP[2].STOP := 3000.0; cv.CORRSTART := 3000.0; cv.CORREND := -1.0;")
     build()
     p.ok(9, "c.ERROR AND c.ERRORID = 10")
