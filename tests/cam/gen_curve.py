@@ -419,8 +419,17 @@ def prog_errors():
     p.check(12, "no curve set yet: VALID FALSE, outputs 0")
     p.check(13, "collinear T segments in a row are accepted (a longer straight line)")
     p.check(14, "BUILD acts on its rising edge only")
+    p.check(15, "fix points so close that the slope overflows (1e10 UU over 1e-300 MU): "
+                "error 12 naming the segment, the curve in use stays")
+    p.check(17, "a start/stop pair with START = STOP, or a whole cycle apart (CAMSYNC would wait "
+                "for START for ever): error 9 naming the pair")
+    p.check(16, "MPOS NaN or 1e300 (beyond 1e15 cycles): every output holds its last value, no jump")
     p.fbs.append("cv : CAM_CURVE;")
     p.fbs.append("c : CAMCURVE;")
+    p.fbs.append("tiny : LREAL;")
+    p.fbs.append("qn : LREAL;")
+    p.fbs.append("spos : LREAL;")
+    p.fbs.append("mcpos : LREAL;")
     good = ([0.0, 1500.0, 2500.0, 4000.0], [0.0, 1200.0, 2400.0, 3600.0], [False, True, False, False])
 
     def build():
@@ -469,6 +478,13 @@ def prog_errors():
     p.line("cv.STARTSTOP[2].START := 2500.0; cv.STARTSTOP[2].STOP := 4500.0;")
     build()
     p.ok(8, "c.ERROR AND c.ERRORID = 9 AND c.ERRPOINT = 2", "INT_TO_LREAL(c.ERRPOINT)")
+    p.line("cv.STARTSTOP[2].STOP := 2500.0;")
+    build()
+    p.ok(17, "c.ERROR AND c.ERRORID = 9 AND c.ERRPOINT = 2", "INT_TO_LREAL(c.ERRPOINT)")
+    p.line("cv.STARTSTOP[2].START := 0.0; cv.STARTSTOP[2].STOP := 4000.0;")
+    build()
+    p.ok(17, "c.ERROR AND c.ERRORID = 9 AND c.ERRPOINT = 2", "INT_TO_LREAL(c.ERRPOINT)")
+    p.line("cv.STARTSTOP[2].START := 2500.0;")
     p.line("cv.STARTSTOP[2].STOP := 3000.0; cv.CORRSTART := 3000.0; cv.CORREND := -1.0;")
     build()
     p.ok(9, "c.ERROR AND c.ERRORID = 10")
@@ -481,6 +497,18 @@ def prog_errors():
     p.ok(14, "NEAR(c.SPOS, 1800.0, 1.0E-9)", "c.SPOS")
     build()
     p.ok(14, "NOT c.ERROR AND NEAR(c.SPOS, 1200.0 + 500.0 * 8.799, 1.0E-9)", "c.SPOS")
+    # 1e-300 and NaN computed: matiec refuses literals beyond the REAL range
+    p.line("tiny := 1.0E-30; tiny := tiny * tiny; tiny := tiny * tiny * tiny * tiny * tiny;")
+    p.line("qn := 0.0; qn := qn / qn;")
+    p.line("spos := c.SPOS; mcpos := c.MCPOS;")
+    p.set_curve("cv", [0.0, 1.0, 1000.0, 4000.0], [0.0, 1.0e10, 1.0e10 + 1.0, 1.0e10 + 2.0])
+    p.line("cv.FIX[1].MASTER := tiny;")
+    build()
+    p.ok(15, "c.ERROR AND c.ERRORID = 12 AND c.ERRPOINT = 0 AND c.VALID AND c.SPOS = spos", "INT_TO_LREAL(c.ERRORID)")
+    p.line("c(BUILD := FALSE, MPOS := qn, CURVE := cv);")
+    p.ok(16, "c.VALID AND c.SPOS = spos AND c.MCPOS = mcpos", "c.SPOS")
+    p.line("c(BUILD := FALSE, MPOS := 1.0E30 / tiny, CURVE := cv);")
+    p.ok(16, "c.VALID AND c.SPOS = spos AND c.MCPOS = mcpos", "c.SPOS")
     return p
 
 

@@ -57,7 +57,8 @@ def main():
         states = [v[4] for v in samples]
         order = [s for i, s in enumerate(states) if i == 0 or s != states[i - 1]]
         report(f"cam_printing: STATE runs waiting, engaging, synchronous, waiting for pair 2, "
-               f"disengaging, stopped: {order}", order[-5:] == [2, 3, 4, 5, 6] and order[0] in (1, 2), order)
+               f"disengaging, stopped: {order}", order[-5:] == [2, 3, 4, 5, 6]
+               and (order[1:] if order[0] == 0 else order)[0] in (1, 2), order)
         eng = [v[1] / 1000 for v in samples if v[4] == 2]
         dis = [v[1] / 1000 for v in samples if v[4] == 5]
         report(f"cam_printing: engaging only inside pair 1, 1000 .. 1500 ({len(eng)} samples, "
