@@ -742,7 +742,7 @@ def t_retain():
     retain = os.path.join(WORK, "epicpos-r.retain")
     p, m = new_plcrt("r1", retain, period=0)
     wait_for(lambda: m.coils(ST["loopon"]), 3.0)
-    q1, q2 = 1800, -2500
+    q1, q2 = -1800, 2500                   # the last move before the restart goes backward
     m.set_md(P["slVelAsse"], 90)
     m.set_md(P["toll"], 8)
     m.set_md(P["taccdec"], 30)
@@ -771,8 +771,9 @@ def t_retain():
            f"posit {posit}, before the restart {posit1}")
     refcnt = m.md(REFCNT)
     report("retain: states come back at their INIT values and start-up succeeds again "
-           "(st_init, st_loopon, no emergency, st_still, not st_toll, refcnt 0)",
-           s["init"] and s["loopon"] and not s["emrg"] and s["still"] and not s["toll"] and refcnt == 0,
+           "(st_init, st_loopon, no emergency, st_still, not st_toll, st_movdir 0 after a backward move, refcnt 0)",
+           s["init"] and s["loopon"] and not s["emrg"] and s["still"] and not s["toll"] and not s["movdir"]
+           and refcnt == 0,
            f"states {s}, refcnt {refcnt}")
     dx, dp = still_for(m, 0.3)
     report("retain: after the restart the axis does not move by itself", dx == 0 and dp == 0,
