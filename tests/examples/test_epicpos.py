@@ -672,11 +672,12 @@ def t_posit_commands(m):
 
 
 def t_calibration(m):
-    """CALON: the DAC outputs vout x 3276.7 (+ offset); the plant runs at that
-    fraction of its speed at 10 V. CALOFF: the axis stops where it is."""
+    """CALON, then vout (seed 1.2.2.1; vout is written only in calibration): the
+    DAC outputs vout x 3276.7 (+ offset); the plant runs at that fraction of
+    its speed at 10 V. CALOFF: the axis stops where it is."""
     settle(m)
-    m.set_md(P["vout"], 10)                     # 1.0 V
     command(m, "CALON")
+    m.set_md(P["vout"], 10)                     # 1.0 V
     time.sleep(0.4)                             # 20 drive time constants
     s, dac, vel = state(m), m.md(DACVAL), m.md(VEL)
     xs, vs = m.sim(0)
@@ -684,6 +685,7 @@ def t_calibration(m):
     report(f"epicpos: CALON with vout 10: st_cal, DAC 3277 (1 V), the plant at {want:.1f} counts/s, "
            f"vel {want * 60:.0f} Um/min", s["cal"] and abs(dac - 3276.7) <= 1 and abs(vs - want) <= 2
            and abs(vel - want * 60) <= 700, f"states {s}, DAC {dac}, plant {vs} counts/s, vel {vel}")
+    m.set_md(P["vout"], 0)                      # back to 0 V while still calibrating
     command(m, "CALOFF")
     time.sleep(0.3)
     s, x1 = state(m), m.sim(0)[0]
@@ -691,7 +693,6 @@ def t_calibration(m):
     report("epicpos: CALOFF: st_cal off, the axis stops where it is (no run back) and stays",
            not s["cal"] and s["still"] and x1 >= xs and dx <= 5 and dp <= 5 and not s["emrg"],
            f"states {s}, plant at CALOFF {xs}, 0.3 s later {x1}, then moved {dx}")
-    m.set_md(P["vout"], 0)
 
 
 def t_default_drive():
@@ -741,7 +742,7 @@ def t_retain():
     retain = os.path.join(WORK, "epicpos-r.retain")
     p, m = new_plcrt("r1", retain, period=0)
     wait_for(lambda: m.coils(ST["loopon"]), 3.0)
-    q1, q2 = 1800, -2500
+    q1, q2 = -1800, 2500                   # the last move before the restart goes backward
     m.set_md(P["slVelAsse"], 90)
     m.set_md(P["toll"], 8)
     m.set_md(P["taccdec"], 30)
@@ -770,8 +771,9 @@ def t_retain():
            f"posit {posit}, before the restart {posit1}")
     refcnt = m.md(REFCNT)
     report("retain: states come back at their INIT values and start-up succeeds again "
-           "(st_init, st_loopon, no emergency, st_still, not st_toll, refcnt 0)",
-           s["init"] and s["loopon"] and not s["emrg"] and s["still"] and not s["toll"] and refcnt == 0,
+           "(st_init, st_loopon, no emergency, st_still, not st_toll, st_movdir 0 after a backward move, refcnt 0)",
+           s["init"] and s["loopon"] and not s["emrg"] and s["still"] and not s["toll"] and not s["movdir"]
+           and refcnt == 0,
            f"states {s}, refcnt {refcnt}")
     dx, dp = still_for(m, 0.3)
     report("retain: after the restart the axis does not move by itself", dx == 0 and dp == 0,
