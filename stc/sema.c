@@ -2064,15 +2064,22 @@ void sema(Unit *u) {
         }
         Type *cf, *cto;
         int typed;
-        if (conv_kind(p->uname, &cf, &cto) != CONV_NONE || find_libfn(p->uname, &typed)) {
+        bool standard = conv_kind(p->uname, &cf, &cto) != CONV_NONE || find_libfn(p->uname, &typed);
+        for (int k = 0; !standard && builtins[k].name; k++) standard = !strcmp(builtins[k].name, p->uname);
+        if (standard && p->kind == POU_FUNCTION) {
+            /* A program's own SEL, MAX or MIN (OpenPLC examples carry
+            ** them): matiec accepts the declaration and calls keep going
+            ** to its standard function. So here: the declaration is
+            ** dropped, with a warning. */
+            warning_at(p->loc, "'%s' is a standard function: calls use the standard one and this declaration is ignored, as in matiec",
+                       p->name);
+            vec_remove(&u->pous, i--);
+            continue;
+        }
+        if (standard) {
             error_at(p->loc, "duplicate declaration of '%s': it is a standard function", p->name);
             continue;
         }
-        for (int k = 0; builtins[k].name; k++)
-            if (!strcmp(builtins[k].name, p->uname)) {
-                error_at(p->loc, "duplicate declaration of '%s': it is a standard function", p->name);
-                goto next_pou;
-            }
         {
             Sym *s = new_sym(SK_POU, p->name, p->uname, p->loc);
             s->pou = p;
@@ -2083,7 +2090,6 @@ void sema(Unit *u) {
             }
             if (!p->from_lib) p->used = true;
         }
-    next_pou:;
     }
     for (int i = 0; i < c.types.n; i++) {
         Sym *s = c.types.v[i];

@@ -23,6 +23,7 @@ char *upcase(const char *s);
 
 typedef struct { void **v; int n, cap; } Vec;
 void vec_push(Vec *v, void *p);
+void vec_remove(Vec *v, int i);          /* keeps the order */
 
 typedef struct { char *s; size_t n, cap; } Buf;   /* growable text */
 void buf_put(Buf *b, const char *s);
