@@ -633,6 +633,18 @@ static Type *check_member(Ctx *c, Node *n) {
         }
         /* an in-out reads the variable the last call connected */
         if (m && (m->cls == V_INPUT || m->cls == V_OUTPUT || m->cls == V_IN_OUT)) { n->sym = m; return m->type; }
+        /* matiec lets a POU read and write a block's plain internal
+        ** variable (inst.busy := TRUE), and editors' exported projects do
+        ** it: accepted with a warning, once a variable. Its internal
+        ** instances, located and temporary variables stay out of reach. */
+        if (m && m->cls == V_LOCAL && !m->pointer && canon(m->type)->kind != T_FB) {
+            if (!m->warned_outside)
+                warning_at(n->loc, "'%s' is an internal variable of '%s': IEC 61131-3 does not let other POUs use it (accepted, as matiec does)",
+                           n->name, t->pou->name);
+            m->warned_outside = true;
+            n->sym = m;
+            return m->type;
+        }
         if (m) {
             error_at(n->loc, "'%s' is an internal variable of '%s', not accessible from outside", n->name, t->pou->name);
             return err_type();

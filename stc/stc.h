@@ -283,6 +283,7 @@ struct Sym {
     bool is_result;       /* the function's return variable */
     bool loop_locked;     /* FOR control variable inside its loop */
     bool implicit;        /* EN / ENO nobody declared: never a positional argument */
+    bool warned_outside;  /* an internal variable used from outside: said once */
 };
 
 extern Type *ty_prim[T__COUNT];
