@@ -1859,7 +1859,8 @@ static Sym *declare_var(Ctx *c, Vec *scope, VarDecl *d, Pou *p) {
     }
     if (d->cls == V_IN_OUT || d->cls == V_EXTERNAL) s->pointer = true;
     if (d->constant && d->cls != V_EXTERNAL && !d->init && d->cls != V_GLOBAL)
-        error_at(d->loc, "constant '%s' needs an initial value", d->name);
+        /* matiec accepts it (OpenPLC examples have such constants) */
+        warning_at(d->loc, "constant '%s' has no initial value: it is its type's initial value", d->name);
     if (d->cls == V_IN_OUT && p && p->kind == POU_FUNCTION) { /* passed by address */ }
     if (canon(s->type)->kind == T_FB && p && p->kind == POU_FUNCTION && d->cls != V_IN_OUT)
         error_at(d->loc, "a function cannot hold a function block instance");
