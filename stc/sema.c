@@ -1622,10 +1622,22 @@ static void check_value(Ctx *c, Type *dst, Node *src) {
 /* ---- initial values ---- */
 static void check_init(Ctx *c, Type *t, Node *init);
 
+/* matiec takes an integer literal as an element of a REAL or LREAL array
+** initializer ([0, 4.228, 5.0], as OSCAT writes its tables), though
+** nowhere else: the literal becomes a real one. */
+static void int_lit_as_real(Type *elem, Node *n) {
+    if (!n || !is_real(canon(elem))) return;
+    if (n->kind == N_UNARY && n->op && !strcmp(n->op, "-")) n = n->lhs;
+    if (n->kind != N_INT || n->ioverflow) return;
+    n->kind = N_REAL;
+    n->rval = n->neg ? -(double)n->ival : (double)n->ival;
+}
+
 static void check_array_init(Ctx *c, Type *t, Node *init) {
     int64_t count = 0;
     for (int i = 0; i < init->list.n; i++) {
         Node *it = init->list.v[i];
+        int_lit_as_real(t->elem, it->kind == N_REPEAT ? it->lhs : it);
         if (it->kind == N_REPEAT) {
             if (it->lhs) check_init(c, t->elem, it->lhs);
             count += (int64_t)it->ival;
