@@ -876,10 +876,12 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         if (g->pou && g->pou->kind == POU_FUNCTION) {
             /* in matiec's C a function's result is a local named like the
                function: C written for matiec assigns it under that name */
-            buf_printf(b, "  /* embedded C */\n#define %s __res\n%s\n#undef %s\n", g->pou->uname, s->sval, g->pou->uname);
+            buf_printf(b, "  /* embedded C */\n#define %s __res\n%s\n;\n#undef %s\n", g->pou->uname, s->sval, g->pou->uname);
             return;
         }
-        buf_printf(b, "  /* embedded C */\n%s\n", s->sval);
+        /* the ';' after the text, as matiec writes it: C whose last
+           statement lacks one (OSCAT's T_PLC_MS for OpenPLC) still builds */
+        buf_printf(b, "  /* embedded C */\n%s\n;\n", s->sval);
         return;
     default:
         return;
