@@ -260,7 +260,11 @@ static bool parse_date(const char **pp, const char *end, int64_t *ns) {
 
 /* After "T#", "TOD#", "D#", "DT#" (and long forms): a time or date literal. */
 static void lex_time(Lexer *L, const char *s, const char *hash, TimeKind k) {
-    const char *p = hash + 1, *stop = p, *end = L->end;
+    const char *p = hash + 1, *stop, *end = L->end;
+    /* blanks after the '#' (T# 30000ms, as an OpenPLC project has it):
+       matiec accepts them */
+    while (p < end && (*p == ' ' || *p == '\t')) p++;
+    stop = p;
     int64_t ns = 0, tod;
     bool ok;
     switch (k) {
