@@ -188,6 +188,25 @@ static void index_expr(G *g, Buf *b, Node *n) {
     buf_put(b, "]");
 }
 
+/* An operand of a comparison. gcc's -Wsign-compare takes a computed
+** narrow unsigned value for a promoted bitwise complement (BYTE#255 - B
+** folds to ~B) and warns on a comparison with it, as in OSCAT's BAND_B:
+** such an operand goes through a compound literal, which gcc does not see
+** through. */
+static void cmp_operand(G *g, Buf *b, Node *n, const char *cop) {
+    Type *t = ct(n->ty);
+    bool narrow = t && (t->kind == T_BYTE || t->kind == T_USINT || t->kind == T_WORD || t->kind == T_UINT);
+    bool cmp = !strcmp(cop, "==") || !strcmp(cop, "!=") || !strcmp(cop, "<") || !strcmp(cop, ">") ||
+               !strcmp(cop, "<=") || !strcmp(cop, ">=");
+    if (!narrow || !cmp || n->kind == N_IDENT || n->kind == N_INT || n->kind == N_TYPED) {
+        expr(g, b, n);
+        return;
+    }
+    buf_printf(b, "((%s){", cty(n->ty));
+    expr(g, b, n);
+    buf_put(b, "})");
+}
+
 static void binary(G *g, Buf *b, Node *n) {
     Type *lt = ct(n->lhs->ty), *rt = ct(n->rhs->ty), *t = ct(n->ty);
     const char *op = n->op;
@@ -276,9 +295,9 @@ static void binary(G *g, Buf *b, Node *n) {
         return;
     }
     buf_put(b, "(");
-    expr(g, b, n->lhs);
+    cmp_operand(g, b, n->lhs, cop);
     buf_printf(b, " %s ", cop);
-    expr(g, b, n->rhs);
+    cmp_operand(g, b, n->rhs, cop);
     buf_put(b, ")");
 }
 
@@ -876,10 +895,12 @@ static void stmt(G *g, Buf *b, Node *s, int ind) {
         if (g->pou && g->pou->kind == POU_FUNCTION) {
             /* in matiec's C a function's result is a local named like the
                function: C written for matiec assigns it under that name */
-            buf_printf(b, "  /* embedded C */\n#define %s __res\n%s\n#undef %s\n", g->pou->uname, s->sval, g->pou->uname);
+            buf_printf(b, "  /* embedded C */\n#define %s __res\n%s\n;\n#undef %s\n", g->pou->uname, s->sval, g->pou->uname);
             return;
         }
-        buf_printf(b, "  /* embedded C */\n%s\n", s->sval);
+        /* the ';' after the text, as matiec writes it: C whose last
+           statement lacks one (OSCAT's T_PLC_MS for OpenPLC) still builds */
+        buf_printf(b, "  /* embedded C */\n%s\n;\n", s->sval);
         return;
     default:
         return;

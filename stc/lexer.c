@@ -8,15 +8,17 @@
 #include <string.h>
 #include <time.h>
 
+/* INTERVAL, PRIORITY and SINGLE are not here: they name task parameters
+** only, and a block may use them as variable names (matiec does too). */
 static const char *reserved[] = {
     "ACTION", "AND", "ANY", "ARRAY", "AT", "BOOL", "BY", "BYTE", "CASE", "CONFIGURATION",
     "CONSTANT", "DATE", "DATE_AND_TIME", "DINT", "DO", "DT", "DWORD", "ELSE", "ELSIF",
     "END_ACTION", "END_CASE", "END_CONFIGURATION", "END_FOR", "END_FUNCTION",
     "END_FUNCTION_BLOCK", "END_IF", "END_PROGRAM", "END_REPEAT", "END_RESOURCE",
     "END_STRUCT", "END_TYPE", "END_VAR", "END_WHILE", "EXIT", "FALSE", "FOR", "FUNCTION",
-    "FUNCTION_BLOCK", "IF", "INT", "INTERVAL", "LINT", "LREAL", "LWORD", "MOD", "NOT", "OF",
-    "ON", "OR", "PRIORITY", "PROGRAM", "READ_ONLY", "READ_WRITE", "REAL", "REPEAT", "RESOURCE",
-    "RETAIN", "NON_RETAIN", "RETURN", "SINGLE", "SINT", "STEP", "END_STEP", "INITIAL_STEP", "TRANSITION", "END_TRANSITION", "FROM",
+    "FUNCTION_BLOCK", "IF", "INT", "LINT", "LREAL", "LWORD", "MOD", "NOT", "OF",
+    "ON", "OR", "PROGRAM", "READ_ONLY", "READ_WRITE", "REAL", "REPEAT", "RESOURCE",
+    "RETAIN", "NON_RETAIN", "RETURN", "SINT", "STEP", "END_STEP", "INITIAL_STEP", "TRANSITION", "END_TRANSITION", "FROM",
     "R_EDGE", "F_EDGE", "STRING", "STRUCT", "TASK", "THEN",
     "TIME", "TIME_OF_DAY", "TO", "TOD", "TRUE", "TYPE", "UDINT", "UINT", "ULINT", "UNTIL",
     "USINT", "VAR", "VAR_ACCESS", "VAR_CONFIG", "VAR_EXTERNAL", "VAR_GLOBAL", "VAR_INPUT",
@@ -258,7 +260,11 @@ static bool parse_date(const char **pp, const char *end, int64_t *ns) {
 
 /* After "T#", "TOD#", "D#", "DT#" (and long forms): a time or date literal. */
 static void lex_time(Lexer *L, const char *s, const char *hash, TimeKind k) {
-    const char *p = hash + 1, *stop = p, *end = L->end;
+    const char *p = hash + 1, *stop, *end = L->end;
+    /* blanks after the '#' (T# 30000ms, as an OpenPLC project has it):
+       matiec accepts them */
+    while (p < end && (*p == ' ' || *p == '\t')) p++;
+    stop = p;
     int64_t ns = 0, tod;
     bool ok;
     switch (k) {

@@ -586,8 +586,10 @@ static bool var_block(P *p, Vec *out, bool global_ok) {
     int first = out->n;
     var_decls(p, out, cls, constant, retain, t, "END_VAR");
     for (int i = first; i < out->n; i++) ((VarDecl *)out->v[i])->non_retain = non_retain;
-    /* matiec wants located variables in VAR blocks of their own */
-    for (int i = first + 1; i < out->n; i++) {
+    /* matiec wants located variables in VAR blocks of their own, except
+    ** in VAR_GLOBAL (the OpenPLC editor writes PLC_CYCLE_COUNT AT %ML1025
+    ** and unlocated globals in one block) */
+    for (int i = first + 1; cls != V_GLOBAL && i < out->n; i++) {
         VarDecl *a = out->v[first], *d = out->v[i];
         if (!a->location != !d->location)
             fatal_at(d->loc, "'%s': located and unlocated variables cannot share a VAR block; give the %s ones a block of their own",

@@ -633,6 +633,18 @@ static Type *check_member(Ctx *c, Node *n) {
         }
         /* an in-out reads the variable the last call connected */
         if (m && (m->cls == V_INPUT || m->cls == V_OUTPUT || m->cls == V_IN_OUT)) { n->sym = m; return m->type; }
+        /* matiec lets a POU read and write a block's plain internal
+        ** variable (inst.busy := TRUE), and editors' exported projects do
+        ** it: accepted with a warning, once a variable. Its internal
+        ** instances, located and temporary variables stay out of reach. */
+        if (m && m->cls == V_LOCAL && !m->pointer && canon(m->type)->kind != T_FB) {
+            if (!m->warned_outside)
+                warning_at(n->loc, "'%s' is an internal variable of '%s': IEC 61131-3 does not let other POUs use it (accepted, as matiec does)",
+                           n->name, t->pou->name);
+            m->warned_outside = true;
+            n->sym = m;
+            return m->type;
+        }
         if (m) {
             error_at(n->loc, "'%s' is an internal variable of '%s', not accessible from outside", n->name, t->pou->name);
             return err_type();
@@ -1610,10 +1622,22 @@ static void check_value(Ctx *c, Type *dst, Node *src) {
 /* ---- initial values ---- */
 static void check_init(Ctx *c, Type *t, Node *init);
 
+/* matiec takes an integer literal as an element of a REAL or LREAL array
+** initializer ([0, 4.228, 5.0], as OSCAT writes its tables), though
+** nowhere else: the literal becomes a real one. */
+static void int_lit_as_real(Type *elem, Node *n) {
+    if (!n || !is_real(canon(elem))) return;
+    if (n->kind == N_UNARY && n->op && !strcmp(n->op, "-")) n = n->lhs;
+    if (n->kind != N_INT || n->ioverflow) return;
+    n->kind = N_REAL;
+    n->rval = n->neg ? -(double)n->ival : (double)n->ival;
+}
+
 static void check_array_init(Ctx *c, Type *t, Node *init) {
     int64_t count = 0;
     for (int i = 0; i < init->list.n; i++) {
         Node *it = init->list.v[i];
+        int_lit_as_real(t->elem, it->kind == N_REPEAT ? it->lhs : it);
         if (it->kind == N_REPEAT) {
             if (it->lhs) check_init(c, t->elem, it->lhs);
             count += (int64_t)it->ival;
@@ -1847,7 +1871,8 @@ static Sym *declare_var(Ctx *c, Vec *scope, VarDecl *d, Pou *p) {
     }
     if (d->cls == V_IN_OUT || d->cls == V_EXTERNAL) s->pointer = true;
     if (d->constant && d->cls != V_EXTERNAL && !d->init && d->cls != V_GLOBAL)
-        error_at(d->loc, "constant '%s' needs an initial value", d->name);
+        /* matiec accepts it (OpenPLC examples have such constants) */
+        warning_at(d->loc, "constant '%s' has no initial value: it is its type's initial value", d->name);
     if (d->cls == V_IN_OUT && p && p->kind == POU_FUNCTION) { /* passed by address */ }
     if (canon(s->type)->kind == T_FB && p && p->kind == POU_FUNCTION && d->cls != V_IN_OUT)
         error_at(d->loc, "a function cannot hold a function block instance");
@@ -2064,15 +2089,22 @@ void sema(Unit *u) {
         }
         Type *cf, *cto;
         int typed;
-        if (conv_kind(p->uname, &cf, &cto) != CONV_NONE || find_libfn(p->uname, &typed)) {
+        bool standard = conv_kind(p->uname, &cf, &cto) != CONV_NONE || find_libfn(p->uname, &typed);
+        for (int k = 0; !standard && builtins[k].name; k++) standard = !strcmp(builtins[k].name, p->uname);
+        if (standard && p->kind == POU_FUNCTION) {
+            /* A program's own SEL, MAX or MIN (OpenPLC examples carry
+            ** them): matiec accepts the declaration and calls keep going
+            ** to its standard function. So here: the declaration is
+            ** dropped, with a warning. */
+            warning_at(p->loc, "'%s' is a standard function: calls use the standard one and this declaration is ignored, as in matiec",
+                       p->name);
+            vec_remove(&u->pous, i--);
+            continue;
+        }
+        if (standard) {
             error_at(p->loc, "duplicate declaration of '%s': it is a standard function", p->name);
             continue;
         }
-        for (int k = 0; builtins[k].name; k++)
-            if (!strcmp(builtins[k].name, p->uname)) {
-                error_at(p->loc, "duplicate declaration of '%s': it is a standard function", p->name);
-                goto next_pou;
-            }
         {
             Sym *s = new_sym(SK_POU, p->name, p->uname, p->loc);
             s->pou = p;
@@ -2083,7 +2115,6 @@ void sema(Unit *u) {
             }
             if (!p->from_lib) p->used = true;
         }
-    next_pou:;
     }
     for (int i = 0; i < c.types.n; i++) {
         Sym *s = c.types.v[i];

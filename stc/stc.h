@@ -23,6 +23,7 @@ char *upcase(const char *s);
 
 typedef struct { void **v; int n, cap; } Vec;
 void vec_push(Vec *v, void *p);
+void vec_remove(Vec *v, int i);          /* keeps the order */
 
 typedef struct { char *s; size_t n, cap; } Buf;   /* growable text */
 void buf_put(Buf *b, const char *s);
@@ -282,6 +283,7 @@ struct Sym {
     bool is_result;       /* the function's return variable */
     bool loop_locked;     /* FOR control variable inside its loop */
     bool implicit;        /* EN / ENO nobody declared: never a positional argument */
+    bool warned_outside;  /* an internal variable used from outside: said once */
 };
 
 extern Type *ty_prim[T__COUNT];

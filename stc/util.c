@@ -98,6 +98,11 @@ void vec_push(Vec *v, void *p) {
     v->v[v->n++] = p;
 }
 
+void vec_remove(Vec *v, int i) {
+    memmove(v->v + i, v->v + i + 1, sizeof(void *) * (size_t)(v->n - i - 1));
+    v->n--;
+}
+
 static void buf_grow(Buf *b, size_t add) {
     if (b->n + add + 1 <= b->cap) return;
     size_t cap = b->cap ? b->cap : 256;

@@ -4,8 +4,17 @@
 #ifndef IEC_STD_LIB_H
 #define IEC_STD_LIB_H
 
+/* The C headers matiec's iec_std_lib.h includes: embedded C written for
+** matiec (time_t, rand(), toupper(), INT_MAX, ...) builds under stc too. */
+#include <ctype.h>
+#include <float.h>
+#include <limits.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include "iec_types.h"
 #include "accessor.h"
 
