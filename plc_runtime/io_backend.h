@@ -62,6 +62,19 @@ typedef struct io_backend_ops {
     size_t (*diag)(void *st, uint16_t *regs, size_t max);
 } io_backend_ops;
 
+/* One input a backend writes into the image, for io_inputs_apart: where,
+** how many bytes, and its name for a message ("[sim.axis0] counter"). */
+typedef struct io_input_use {
+    const uint8_t *p;
+    unsigned w;
+    char who[96];
+} io_input_use;
+/* For a backend's open(): 0 when no two of the n inputs share a byte of
+** the image, else -1 with "A and B write the same input: give each its own
+** address" in err (two bindings copied and not edited would leave the
+** program one of them only, without a word). */
+int io_inputs_apart(const io_input_use *in, int n, char *err, size_t errlen);
+
 /* The backend named name, or NULL. */
 const io_backend_ops *io_backend_find(const char *name);
 /* NULL-terminated list of all backends (for section ownership and help). */

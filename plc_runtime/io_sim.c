@@ -245,7 +245,7 @@ static int config(void *st, const char *sec, const char *key, const char *v, cha
 ** DAC: two drives on one speed reference.) 0, or -1 naming both. */
 static int inputs_apart(sim *s, plc_image *img, char *err, size_t n)
 {
-    struct { const uint8_t *p; unsigned w; char who[40]; } in[SIM_AXES * NBIND + 1 + SIM_MARKERS * NMBIND];
+    io_input_use in[SIM_AXES * NBIND + 1 + SIM_MARKERS * NMBIND];
     int k = 0;
     for (int i = 0; i < SIM_AXES; i++)
         for (int b = B_COUNTER; b < NBIND && s->ax[i].used; b++)
@@ -266,13 +266,7 @@ static int inputs_apart(sim *s, plc_image *img, char *err, size_t n)
                 in[k].w = plc_loc_width(&s->mk[i].loc[b]);
                 snprintf(in[k++].who, sizeof in[0].who, "[sim.marker%d] %s", i, mbind_keys[b]);
             }
-    for (int i = 0; i < k; i++)
-        for (int j = 0; j < i; j++)
-            if (in[i].p < in[j].p + in[j].w && in[j].p < in[i].p + in[i].w) {
-                snprintf(err, n, "%s and %s write the same input: give each its own address", in[j].who, in[i].who);
-                return -1;
-            }
-    return 0;
+    return io_inputs_apart(in, k, err, n);
 }
 
 static int open_(void *st, plc_image *img, uint64_t tick, char *err, size_t n)

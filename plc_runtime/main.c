@@ -165,6 +165,18 @@ static int configure(plc_config *cfg, const char *file, const plc_program *prog,
 ** lands in them after that. Save, release, and say so in one line; after
 ** SIGTERM (a service manager, a test) the statistics are printed too, after
 ** Ctrl-C (SIGINT, a person at the terminal) only that line. */
+/* Once the scan no longer touches them: the image's outputs zeroed, the
+** backend's physical outputs to their safe state (0 V, off). */
+static void outputs_safe(plc_config *cfg)
+{
+    memset(plc_img.qx, 0, sizeof plc_img.qx);
+    memset(plc_img.qb, 0, sizeof plc_img.qb);
+    memset(plc_img.qw, 0, sizeof plc_img.qw);
+    memset(plc_img.qd, 0, sizeof plc_img.qd);
+    memset(plc_img.ql, 0, sizeof plc_img.ql);
+    cfg->io->safe_state(cfg->io_state, &plc_img);
+}
+
 static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc_config *cfg, retained *ret,
                       int sig)
 {
@@ -172,12 +184,7 @@ static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc
     pthread_join(th, NULL);
     mb_server_stop(srv);
     if (mb) mb_drain(mb, &plc_img);
-    memset(plc_img.qx, 0, sizeof plc_img.qx);
-    memset(plc_img.qb, 0, sizeof plc_img.qb);
-    memset(plc_img.qw, 0, sizeof plc_img.qw);
-    memset(plc_img.qd, 0, sizeof plc_img.qd);
-    memset(plc_img.ql, 0, sizeof plc_img.ql);
-    cfg->io->safe_state(cfg->io_state, &plc_img);
+    outputs_safe(cfg);
     uint64_t errs = atomic_load(&sc->retain_errors);
     retain_now(sc, ret, cfg, 0);
     if (sig != SIGINT) stats_print(stderr, &sc->stats, sc->period_ns);
@@ -256,12 +263,7 @@ static _Noreturn void watchdog_halt(scan *sc, mb_server *srv, plc_config *cfg)
             "= %d (an endless loop? a loop bound from a variable?): outputs to their safe state, plcrt stops",
             ms, cfg->watchdog_ms);
     mb_server_stop(srv);
-    memset(plc_img.qx, 0, sizeof plc_img.qx);
-    memset(plc_img.qb, 0, sizeof plc_img.qb);
-    memset(plc_img.qw, 0, sizeof plc_img.qw);
-    memset(plc_img.qd, 0, sizeof plc_img.qd);
-    memset(plc_img.ql, 0, sizeof plc_img.ql);
-    cfg->io->safe_state(cfg->io_state, &plc_img);
+    outputs_safe(cfg);
     if (!cfg->retain_file[0])
         fprintf(stderr, "plcrt: stopped by the watchdog: outputs safe (DAC 0 V), nothing retained\n");
     else

@@ -428,7 +428,7 @@ static void loc_text(const plc_loc *l, char *out, size_t n)
 ** objects.) 0, or -1 naming both. */
 static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
 {
-    struct { const uint8_t *p; unsigned w; char who[96]; } in[MAX_BINDS + 2 * MAX_NODES];
+    io_input_use in[MAX_BINDS + 2 * MAX_NODES];
     int k = 0;
     char t[32];
     for (int i = 0; i < s->nbinds; i++) {
@@ -455,13 +455,7 @@ static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
             in[k].w = plc_loc_width(l);
             snprintf(in[k++].who, sizeof in[0].who, "[%.40s] %s %s", s->ex[i].name, j ? "ok" : "status", t);
         }
-    for (int i = 0; i < k; i++)
-        for (int j = 0; j < i; j++)
-            if (in[i].p < in[j].p + in[j].w && in[j].p < in[i].p + in[i].w) {
-                snprintf(err, n, "%s and %s write the same input: give each its own address", in[j].who, in[i].who);
-                return -1;
-            }
-    return 0;
+    return io_inputs_apart(in, k, err, n);
 }
 
 static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
