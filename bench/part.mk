@@ -31,9 +31,9 @@ BENCHES += bench-epicpos
 
 # LJPROF: p50/p99 cost of a re-plan call in stc's generated C, and planned
 # durations against Ruckig on thousands of random moves (bench/ljprof/)
-$(BENCH_B)/ljprof/replan: bench/ljprof/replan.c tests/ljprof/drive.st st/ljprof.st $(STC) tests/common/st_build.sh
+$(BENCH_B)/ljprof/replan: bench/ljprof/replan.c tests/ljprof/drive.st st/parts/ljprof.st $(STC) tests/common/st_build.sh
 	@rm -rf $(@D) && mkdir -p $(@D)
-	cat st/ljprof.st tests/ljprof/drive.st > $(@D)/all.st
+	cat st/parts/ljprof.st tests/ljprof/drive.st > $(@D)/all.st
 	@bash -c '. tests/common/st_build.sh && STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" \
 	    CFLAGS="$(CFLAGS)" && st_compile $(@D)/all.st $(@D) bench-ljprof && \
 	    st_link $(@D) bench/ljprof/replan.c $@ bench-ljprof'

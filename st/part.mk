@@ -1,12 +1,15 @@
 # st/: the positioner library in Structured Text.  The library is one file,
 # build/st/epicpos.st (the sources concatenated in dependency order), which a
 # PLC project puts in front of its own program before compiling it.
-ST_LIB_SRC := st/epicutil.st st/epicprof.st st/ljprof.st st/poscount.st st/pidff.st st/isgdamp.st \
-              st/apossctl.st st/prssearch.st st/zlatch.st st/epicpos.st \
-              st/plcopen_axis.st st/plcopen.st
-ST_LIB_SRC += st/camcurve.st st/cambox.st st/camsync.st
-ST_LIB_SRC += st/apossaxis.st st/plcopen_aposs.st
-ST_LIB_SRC += st/plcopen_sync.st
+# The three layers of DESIGN.md section 7, each in its own folder, in
+# dependency order: parts know nothing of devices, devices nothing of PLCopen.
+ST_PARTS   := $(addprefix st/parts/,epicutil.st epicprof.st ljprof.st poscount.st \
+              pidff.st isgdamp.st apossctl.st prssearch.st zlatch.st \
+              camcurve.st cambox.st camsync.st)
+ST_DEVICES := $(addprefix st/devices/,epicpos.st apossaxis.st)
+ST_PLCOPEN := $(addprefix st/plcopen/,plcopen_axis.st plcopen.st plcopen_aposs.st \
+              plcopen_sync.st)
+ST_LIB_SRC := $(ST_PARTS) $(ST_DEVICES) $(ST_PLCOPEN)
 ST_LIB     := $(BUILD)/st/epicpos.st
 
 ALL += $(ST_LIB)

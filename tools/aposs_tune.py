@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """aposs_tune: the "ten steps for optimum control" of seed 001, automated, on
-a running plcrt with an APOSSAXIS (st/apossaxis.st) whose parameters,
+a running plcrt with an APOSSAXIS (st/devices/apossaxis.st) whose parameters,
 commands and outputs are on Modbus symbols (examples/aposs/aposs.ini shows
 the map).  Each test run is a POSA recorded cycle by cycle with the trace
 (plc_runtime/plctrace, docs/trace.md); the steps:

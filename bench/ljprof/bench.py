@@ -5,7 +5,7 @@ how the planned durations compare with Ruckig's on thousands of moves.
     bench.py REPLAN DRIVE [CASES]
 
 REPLAN is bench/ljprof/replan.c built with tests/ljprof/drive.st and
-st/ljprof.st at -O2; DRIVE the test harness of tests/ljprof (the same
+st/parts/ljprof.st at -O2; DRIVE the test harness of tests/ljprof (the same
 block, sampled).  The Ruckig comparison is tests/ljprof/ruckig_peer.py run
 on more cases and another seed.  Prints the figures and the verdicts against
 the targets: p99 of a re-plan call <= 5 us, durations within 1e-6 of

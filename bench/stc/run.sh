@@ -7,7 +7,7 @@ mkdir -p "$out"
 cd "$(dirname "$0")/../.."
 
 echo "== stc compile time (mean of 10 runs each)"
-for f in $(ls st/*.st examples/*/*.st bench/stc/*.st 2>/dev/null); do
+for f in $(ls st/*/*.st examples/*/*.st bench/stc/*.st 2>/dev/null); do
     start=$(date +%s%N)
     for _ in 1 2 3 4 5 6 7 8 9 10; do "$stc" -T "$out/ct" "$f" >/dev/null 2>&1 || true; done
     end=$(date +%s%N)

@@ -404,7 +404,7 @@ def prog_mixed():
 
 def prog_errors():
     p = Prog("t_curve_errors", "CAMCURVE refuses bad curves with an error code naming the "
-             "problem (the header of st/camcurve.st) and keeps the curve in use.")
+             "problem (the header of st/parts/camcurve.st) and keeps the curve in use.")
     p.check(1, "fewer than 3 fix points: error 1 (seed: at least three fix points)")
     p.check(2, "more than 1024 fix points: error 2")
     p.check(3, "master positions not increasing: error 3 naming the point")

@@ -1,4 +1,4 @@
-# ISGDAMP tests (st/isgdamp.st, docs/isg.md):
+# ISGDAMP tests (st/parts/isgdamp.st, docs/isg.md):
 #  - test-isg: ST programs checking the part's behaviour (refusals, pass-through,
 #    clamp, standstill, damping on the plant), run by the EPICPOS harness;
 #  - test-isg-filters: the coefficients the part computes, dumped by coef.st and

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The ISG damping part's filters (st/isgdamp.st) against their
+"""The ISG damping part's filters (st/parts/isgdamp.st) against their
 specification (docs/isg.md), evaluated with scipy on the coefficients the
 ST block computed (dumped by tests/isg/coef.st through tests/isg/dump.c).
 

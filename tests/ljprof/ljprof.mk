@@ -16,9 +16,9 @@ test-ljprof: $(ST_LIB) $(STC)
 	@mk/suite.sh $(RESULTS) ljprof env STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" \
 	    CFLAGS="$(CFLAGS) $(SAN)" tests/ljprof/run.sh $(LJPROF_B) $(ST_LIB) $(LJPROF_TESTS)
 
-$(LJPROF_B)/drive/drive: tests/ljprof/drive.c tests/ljprof/drive.st st/ljprof.st $(STC) tests/common/st_build.sh
+$(LJPROF_B)/drive/drive: tests/ljprof/drive.c tests/ljprof/drive.st st/parts/ljprof.st $(STC) tests/common/st_build.sh
 	@rm -rf $(@D) && mkdir -p $(@D)
-	cat st/ljprof.st tests/ljprof/drive.st > $(@D)/all.st
+	cat st/parts/ljprof.st tests/ljprof/drive.st > $(@D)/all.st
 	@bash -c '. tests/common/st_build.sh && STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" \
 	    CFLAGS="$(CFLAGS) $(SAN)" && st_compile $(@D)/all.st $(@D) ljprof-ruckig/build && \
 	    st_link $(@D) tests/ljprof/drive.c $@ ljprof-ruckig/build'

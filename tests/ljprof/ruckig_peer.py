@@ -3,7 +3,7 @@
 
     ruckig_peer.py DRIVE [CASES] [SEED]
 
-DRIVE is the compiled LJDRIVE harness (drive.c + drive.st + st/ljprof.st):
+DRIVE is the compiled LJDRIVE harness (drive.c + drive.st + st/parts/ljprof.st):
 it runs the ST block sample by sample for each case fed on its standard
 input.  Cases are random: half from rest, half from moving states (speed and
 acceleration within the limits, target speed and acceleration 0), with the
