@@ -4,6 +4,7 @@ Report: PASS/FAIL lines in mk/suite.sh's format under a suite prefix.
 wait_for: poll a condition until it holds or a timeout passes.
 Process: a child whose output lines are echoed and kept with their time.
 Plcrt: a plcrt started on a configuration, its output in a log file.
+default_signals: the state a child should start in, whatever started us.
 """
 import os
 import signal
@@ -50,7 +51,8 @@ class Process:
     in front and kept with its arrival time for seen() and wait()."""
 
     def __init__(self, argv, tag):
-        self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                  preexec_fn=default_signals)
         self.tag = tag
         self.lines = []
         threading.Thread(target=self._read, daemon=True).start()
@@ -67,6 +69,21 @@ class Process:
     def wait(self, text, timeout, since=0.0):
         wait_for(lambda: self.seen(text, since) is not None, timeout)
         return self.seen(text, since)
+
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGQUIT, signal.SIGTERM, signal.SIGHUP)
+
+
+def default_signals():
+    """In a child before exec (preexec_fn): the stop signals at their default
+    action and none blocked. A shell script's `make test &`, nohup or a CI
+    job hands its children SIGINT and SIGQUIT (or SIGHUP) ignored, and an
+    ignored signal stays ignored across exec: plcrt, which keeps an ignored
+    SIGQUIT or SIGHUP ignored as nohup asks, would then not be the plcrt a
+    user starts from a terminal."""
+    for sig in STOP_SIGNALS:
+        signal.signal(sig, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_SETMASK, [])
 
 
 def free_port():
@@ -86,7 +103,8 @@ class Plcrt:
         Plcrt.running.append(self)
         self.logpath = os.path.join(work, f"{name}-{Plcrt.count}.log")
         self.log = open(self.logpath, "w+")
-        self.p = subprocess.Popen([exe, "-c", cfg], stdout=self.log, stderr=self.log)
+        self.p = subprocess.Popen([exe, "-c", cfg], stdout=self.log, stderr=self.log,
+                                  preexec_fn=default_signals)
         for _ in range(200):
             if "modbus: listening" in self.output():
                 return

@@ -147,13 +147,17 @@ def finish(name, body):
     sys.exit(1 if failed else 0)
 
 
-def start_example(name, plcrt, ini, work):
+def start_example(name, plcrt, ini, work, view=None):
     """plcrt on the example's configuration, with a free port and a fresh
-    retain file in work: (the Plcrt, its Modbus port)."""
+    retain file in work: (the Plcrt, its Modbus port). A view
+    (tests/common/onecycle.py) adds the symbols it reads in one request."""
     os.makedirs(work, exist_ok=True)
     for f in os.listdir(work):
         if f.startswith(name):
             os.unlink(os.path.join(work, f))
     port = free_port()
     retain = os.path.join(work, name + ".retain")
-    return Plcrt(plcrt, example_ini(ini, os.path.join(work, name + ".ini"), port, retain), work, name), port
+    cfg = example_ini(ini, os.path.join(work, name + ".ini"), port, retain)
+    if view is not None:
+        view.add_to(cfg)
+    return Plcrt(plcrt, cfg, work, name), port

@@ -18,6 +18,7 @@ import time
 
 import exlib
 from exlib import example_ini, free_port, report
+from peer import default_signals
 
 tree, ini, work = os.path.abspath(sys.argv[1]), sys.argv[2], os.path.abspath(sys.argv[3])
 os.makedirs(work, exist_ok=True)
@@ -28,6 +29,7 @@ myini = example_ini(ini, os.path.join(work, "ctrlc.ini"), port, retain)
 env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
 pid, fd = pty.fork()
 if pid == 0:
+    default_signals()           # a terminal's make: Ctrl-C not ignored, whatever started the tests
     os.chdir(tree)
     os.execvpe("make", ["make", "--no-print-directory", "run-epicpos", f"INI={myini}"], env)
 

@@ -15,7 +15,9 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from exlib import Mb, finish, report, start_example, stop_and_exit_check, wait_for  # noqa: E402
+from onecycle import View  # noqa: E402
 
 PLCRT, INI, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
 RUN, ON = 0, 1                  # coils: run, axis 1..3 on the DAC (1..3)
@@ -27,13 +29,20 @@ TOLL = 2                        # the program's toll for all three axes
 PARK = TOLL + 1
 
 
+# the coils, the status registers and the three plants, read in one request
+# (so from one cycle: tests/common/onecycle.py)
+P = "CONFIG0.RES0.AXES."
+VIEW = View([(f"on{i}", f"{P}ON{i}", "BOOL") for i in (1, 2, 3)]
+            + [(f"pos{i}", f"{P}POS{i}", "DINT") for i in (1, 2, 3)]
+            + [("cur", P + "CURRENT", "DINT"), ("moves", P + "MOVES", "DINT")], sim_axes=3)
+
+
 def snapshot(m):
-    """One consistent view: the status registers come from one cycle."""
-    on = m.coils(ON, 3)
-    pos1, pos2, pos3, cur, moves = m.md(STATUS, 5)
-    on2 = m.coils(ON, 3)
-    return {"t": time.monotonic(), "pos": [pos1, pos2, pos3], "cur": cur, "moves": moves,
-            "on": on2, "on_same": on == on2, "sim": [m.sim(a)[0] for a in range(3)]}
+    """One cycle's view of the axes, the DAC switch and the plants."""
+    v = VIEW.read(m.c)
+    return {"t": time.monotonic(), "pos": [v["pos1"], v["pos2"], v["pos3"]], "cur": v["cur"],
+            "moves": v["moves"], "on": [bool(v[f"on{i}"]) for i in (1, 2, 3)],
+            "sim": [pos for pos, _ in v["sim"]]}
 
 
 def watch(m, secs, quotas, log):
@@ -60,7 +69,7 @@ def reached(log, axis, target):
 
 
 def main():
-    p, port = start_example("multiaxis", PLCRT, INI, WORK)
+    p, port = start_example("multiaxis", PLCRT, INI, WORK, VIEW)
 
     def body():
         m = Mb(port)
@@ -86,8 +95,7 @@ def main():
             at = [k for k, (s, _) in enumerate(log) if s["cur"] != i + 1 and abs(s["pos"][i] - quotas[i]) <= TOLL]
             home.append(bool(at) and any(s["cur"] != i + 1 and abs(s["pos"][i]) <= TOLL for s, _ in log[at[0]:]))
         report("multiaxis: after the round of quotas each axis goes back to 0 within toll", all(home), home)
-        # the coils read before and after the registers agree: a view of one cycle
-        seen = [(s["cur"], s["on"]) for s, _ in log if s["on_same"]]
+        seen = [(s["cur"], s["on"]) for s, _ in log]
         onmatch = all(on[cur - 1] or not any(on) for cur, on in seen if 1 <= cur <= 3)
         report("multiaxis: the axis on the DAC is the one being positioned, each in turn",
                onmatch and {c for c, _ in seen} == {1, 2, 3}, str(seen[:: max(1, len(seen) // 20)]))

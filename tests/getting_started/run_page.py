@@ -35,7 +35,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import free_port  # noqa: E402
+from peer import default_signals, free_port  # noqa: E402
 
 page, tree, work = sys.argv[1], os.path.abspath(sys.argv[2]), os.path.abspath(sys.argv[3])
 port = free_port()
@@ -84,7 +84,7 @@ def sh(code, timeout=120):
     cwd = open(cwdfile).read().strip()
     script = (f"set -a\n. {shlex.quote(envfile)}\ncd {shlex.quote(cwd)}\nset -e\n{code}\n"
               f"export -p > {shlex.quote(envfile)}\npwd > {shlex.quote(cwdfile)}\n")
-    p = subprocess.run(["bash", "-c", script], env=env, stdin=subprocess.DEVNULL,
+    p = subprocess.run(["bash", "-c", script], env=env, stdin=subprocess.DEVNULL, preexec_fn=default_signals,
                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
     return p.returncode, p.stdout
 
@@ -149,7 +149,7 @@ while i < len(blocks):
         cwd = open(cwdfile).read().strip()
         log = os.path.join(work, "background.log")
         script = f"set -a\n. {shlex.quote(envfile)}\ncd {shlex.quote(cwd)}\n{body}"
-        p = subprocess.Popen(["bash", "-c", script], env=env, stdin=subprocess.DEVNULL,
+        p = subprocess.Popen(["bash", "-c", script], env=env, stdin=subprocess.DEVNULL, preexec_fn=default_signals,
                              stdout=open(log, "w"), stderr=subprocess.STDOUT, start_new_session=True)
         bg = (p, log)
         end, up = time.time() + 60, False
@@ -250,7 +250,7 @@ if mdir and os.path.exists(axis):
         ini = os.path.join(proj, "matiec.ini")
         open(ini, "w").write(open(os.path.join(proj, "plcrt.ini")).read().replace("port = 1502", f"port = {port}")
                              .replace(f"port = {port_page}", f"port = {port}"))
-        q = subprocess.Popen([os.path.join("build-matiec", "plcrt"), "-c", "matiec.ini"], cwd=proj,
+        q = subprocess.Popen([os.path.join("build-matiec", "plcrt"), "-c", "matiec.ini"], cwd=proj, preexec_fn=default_signals,
                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         from pymodbus.client import ModbusTcpClient
         c = ModbusTcpClient("127.0.0.1", port=port)

@@ -15,7 +15,7 @@ import sys
 from pymodbus.client import ModbusTcpClient
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Plcrt, Report, free_port, wait_for  # noqa: E402
+from peer import Plcrt, Report, default_signals, free_port, wait_for  # noqa: E402
 
 PLCRT, WORK = sys.argv[1], sys.argv[2]
 report = Report("signals")
@@ -78,7 +78,7 @@ def test_nohup():
     cfg = ini(port, os.path.join(WORK, "nohup.retain"))
     log = open(os.path.join(WORK, "nohup.log"), "w+")
     p = subprocess.Popen([PLCRT, "-c", cfg], stdout=log, stderr=subprocess.STDOUT,
-                         preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
+                         preexec_fn=lambda: (default_signals(), signal.signal(signal.SIGHUP, signal.SIG_IGN)))
     try:
         ok = wait_for(lambda: "running CONFIG0" in open(log.name).read(), 10)
         p.send_signal(signal.SIGHUP)
