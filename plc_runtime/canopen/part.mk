@@ -79,6 +79,7 @@ bus-backend: $(CO_BUILD)/xstate_shim.so $(CO_BUILD)/xstate_guest
 canopen_bus: $(CO_BUILD)/co_testmaster | bus-backend
 	@mk/suite.sh $(RESULTS) canopen_bus env BUS_RUN="$(BUS_RUN)" tests/canopen/run_bus.sh $(CO_BUILD)
 TESTS += canopen_bus
+STRESS_TESTS += canopen_bus
 
 # the plcrt backend `canopen` (built once the runtime's interface is there);
 # plcrt links $(CO_BACKEND)

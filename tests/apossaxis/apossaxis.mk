@@ -15,6 +15,7 @@ test-apossaxis: $(ST_LIB) $(STC)
 # the APOSS example under plcrt, over Modbus and the trace (1.5 to 3 min:
 # some 50 test moves in real time, more where scans come late)
 TESTS += test-apossaxis-tune
+STRESS_TESTS += test-apossaxis-tune
 .PHONY: test-apossaxis-tune
 test-apossaxis-tune: $(BUILD)/plc/aposs/plcrt
 	@mk/suite.sh $(RESULTS) apossaxis-tune python3 tests/apossaxis/test_tune.py \

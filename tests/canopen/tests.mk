@@ -8,6 +8,7 @@ canopen_plcrt: $(BUILD)/plc/canopen_io/plcrt | bus-backend
 	@mk/suite.sh $(RESULTS) canopen_plcrt $(BUS_RUN) $(CO_BUILD)/uml_plcrt \
 	  @PY@ tests/canopen/plcrt_bus_test.py $(BUILD)/plc/canopen_io/plcrt $(CO_BUILD)/uml_plcrt
 TESTS += canopen_plcrt
+STRESS_TESTS += canopen_plcrt
 
 # the CAN-driven axis, once the positioner library is there
 ifneq ($(ST_LIB),)
@@ -17,4 +18,5 @@ canopen_axis: $(BUILD)/plc/canopen_axis/plcrt | bus-backend
 	@mk/suite.sh $(RESULTS) canopen_axis $(BUS_RUN) $(CO_BUILD)/uml_axis \
 	  @PY@ tests/canopen/plcrt_axis_test.py $(BUILD)/plc/canopen_axis/plcrt $(CO_BUILD)/uml_axis
 TESTS += canopen_axis
+STRESS_TESTS += canopen_axis
 endif

@@ -16,9 +16,19 @@ other must come from one request. Two ways to get that here:
   counter is read before and after the reads and the reads are repeated
   until it did not move. Suits programs whose period is long against a
   request's round trip (10 ms and more); at 1 ms use a View.
+- Recording: how long something lasts, or what happened in which cycle,
+  comes from plctrace's cycle-exact trace, never from the test's clock:
+  the recording is armed, and confirmed armed, before the stimulus.
 """
+import csv
+import os
 import re
 import struct
+import subprocess
+
+from peer import default_signals
+
+PLCTRACE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "plc_runtime", "plctrace")
 
 SYMBOLS = 1152        # first input register free for the symbol map
 BACKEND = 1088        # the backend's registers (sim: 4 per axis)
@@ -103,3 +113,35 @@ def same_cycle(client, reads, tries=200, unit=1):
             return v
     raise RuntimeError(f"no {tries} reads fitted in one cycle: the period is too short "
                        "for this check (put the values in one request: onecycle.View)")
+
+
+class Recording:
+    """plctrace record in the background, on plcrt's Modbus port: the
+    constructor returns once plctrace says it is armed (plcrt looks for the
+    trigger from then on), so the stimulus may follow at once. rows() waits
+    for the capture: [(cycle, PLC time in ms, [value per channel])], one
+    row per sample."""
+
+    def __init__(self, port, chans, trigger, samples, path, pre=0, every=1, timeout=60):
+        argv = [PLCTRACE, "--port", str(port), "record", "--trigger", trigger, "--pre", str(pre),
+                "--samples", str(samples), "--every", str(every), "--timeout", str(timeout),
+                "--no-plot", "-o", path]
+        for c in chans:
+            argv += ["--chan", c]
+        self.path, self.err = path, []
+        self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                  preexec_fn=default_signals)
+        for line in self.p.stderr:
+            self.err.append(line)
+            if line.startswith("armed"):
+                return
+        self.p.wait()
+        raise RuntimeError("plctrace did not arm: " + "".join(self.err)[-500:])
+
+    def rows(self, timeout=120):
+        out, err = self.p.communicate(timeout=timeout)
+        if self.p.returncode != 0:
+            raise RuntimeError(f"plctrace record: status {self.p.returncode}: " + ("".join(self.err) + err)[-500:])
+        with open(self.path) as f:
+            r = list(csv.reader(f))
+        return [(int(row[1]), float(row[0]), [float(x) for x in row[2:]]) for row in r[1:]]

@@ -4,3 +4,4 @@
 test-docs-scripts: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/cam_stamping/plcrt
 	@mk/suite.sh $(RESULTS) docs-scripts sh tests/docs/run.sh $(BUILD)/tests/docs
 TESTS += test-docs-scripts
+STRESS_TESTS += test-docs-scripts

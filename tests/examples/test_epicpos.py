@@ -25,6 +25,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from exlib import MD, Mb, Plcrt, example_ini, free_port, report, wait_for  # noqa: E402
 import exlib  # noqa: E402
+from onecycle import Recording, View  # noqa: E402
 
 PLCRT, INI, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
 
@@ -46,6 +47,23 @@ POSIT, VEL, FOLTERR, REFCNT, REFCODE, PARERR, DACVAL = 40, 41, 43, 48, 49, 50, 5
 DEFAULTS = {"slQuotaPos": 2000, "slVelAsse": 50, "cnratio": 100000, "maxpos": 999999,
             "minpos": -999999, "maxvel": 100000, "toll": 5, "taccdec": 100, "toldly": 10,
             "pgain": 10, "feedfw": 1000}
+
+# what a check compares, read in one request (so from one cycle): the
+# program's posit, vel and state coils and the plant (tests/common/onecycle.py)
+PRG = "CONFIG0.RES0.AXIS."
+VIEW = View([(n, PRG + n.upper(), "DINT") for n in ("posit", "vel", "folterr", "dacval", "refcnt", "refcode")]
+            + [(n, PRG + n.upper(), "BOOL") for n in ("ofToll", "ofAxeFermo")]
+            + [(n, PRG + "ST_" + n.upper(), "BOOL") for n in ST], sim_axes=1)
+
+
+def snap(m):
+    """One cycle: posit, vel, folterr, dacval, refcnt, refcode, ofToll,
+    ofAxeFermo, the states by name ('st') and the plant ('x', 'v')."""
+    v = VIEW.read(m.c)
+    v["st"] = {n: bool(v[n]) for n in ST}
+    v["x"], v["v"] = v["sim"][0]
+    return v
+
 
 MAXVEL_UMS = 100000 / 60.0      # maxvel, Um/min -> Um/s
 SIM = exlib.ini_section(INI, "sim.axis0")
@@ -140,31 +158,27 @@ def move(m, quota, timeout):
 def follow(m, timeout, done=lambda s: s["still"] and s["toll"]):
     """Sample posit, vel and the plant while waiting for done(state);
     returns (samples, last state). A sample: (t, posit, vel, sim position,
-    [ofToll, ofAxeFermo], st_still), the coils read in one request (one cycle)."""
+    [ofToll, ofAxeFermo], st_still), all of one cycle."""
     samples, t0 = [], time.monotonic()
     while True:
-        posit, vel = m.md(POSIT, 2)
-        pos, _ = m.sim(0)
-        b = m.coils(OFTOLL, ST["cntrev"] - OFTOLL + 1)
-        s = {n: b[c - OFTOLL] for n, c in ST.items()}
-        samples.append((time.monotonic() - t0, posit, vel, pos, b[:2], s["still"]))
+        v = snap(m)
+        s = v["st"]
+        samples.append((time.monotonic() - t0, v["posit"], v["vel"], v["x"],
+                        [bool(v["ofToll"]), bool(v["ofAxeFermo"])], s["still"]))
         if done(s) or time.monotonic() - t0 > timeout:
-            # posit was read before the state: on a loaded machine the axis may
-            # have gone on between the requests, so read it once more
-            posit, vel = m.md(POSIT, 2)
-            samples.append((time.monotonic() - t0, posit, vel, m.sim(0)[0], b[:2], s["still"]))
             return samples, s
 
 
 def still_for(m, secs):
     """How far the plant and posit stray over secs from where they are now
     (counts, Um): 0 for an axis at rest, within toll for one settling."""
-    p0, (x0, _) = m.md(POSIT), m.sim(0)
+    v0 = snap(m)
     dx = dp = 0
     end = time.monotonic() + secs
     while time.monotonic() < end:
-        dx = max(dx, abs(m.sim(0)[0] - x0))
-        dp = max(dp, abs(m.md(POSIT) - p0))
+        v = snap(m)
+        dx = max(dx, abs(v["x"] - v0["x"]))
+        dp = max(dp, abs(v["posit"] - v0["posit"]))
         time.sleep(0.02)
     return dx, dp
 
@@ -185,7 +199,7 @@ def settle(m, timeout=3.0):
 
 def new_plcrt(tag, retain, period=None):
     port = free_port()
-    cfg = example_ini(INI, os.path.join(WORK, f"epicpos-{tag}.ini"), port, retain, period)
+    cfg = VIEW.add_to(example_ini(INI, os.path.join(WORK, f"epicpos-{tag}.ini"), port, retain, period))
     p = Plcrt(PLCRT, cfg, WORK, "epicpos")
     return p, Mb(port)
 
@@ -214,9 +228,9 @@ def t_startup(m):
     pr = params(m)
     bad = {k: (pr[k], v) for k, v in DEFAULTS.items() if pr[k] != v}
     report("epicpos: set-up registers hold the documented initial values", not bad, f"(got, expected) {bad}")
-    x, v = m.sim(0)
-    report("epicpos: after start-up the axis is still at 0", m.md(POSIT) == 0 and x == 0 and v == 0,
-           f"posit {m.md(POSIT)}, plant {x} counts at {v} counts/s")
+    v = snap(m)
+    report("epicpos: after start-up the axis is still at 0", v["posit"] == 0 and v["x"] == 0 and v["v"] == 0,
+           f"posit {v['posit']}, plant {v['x']} counts at {v['v']} counts/s")
 
 
 def t_first_move(m):
@@ -225,10 +239,11 @@ def t_first_move(m):
     m.set_md(P["slVelAsse"], pct)
     start_move(m, quota)
     samples, s = follow(m, 8.0)
-    posit, pos = m.md(POSIT), m.sim(0)[0]
+    v = snap(m)
+    posit, pos = v["posit"], v["x"]
     report("epicpos: START positions to slQuotaPos within toll, st_toll and ofToll on, "
-           "ofAxeFermo on", s["toll"] and abs(posit - quota) <= 5 and m.coils(OFTOLL, 2) == [True, True],
-           f"posit {posit}, states {s}")
+           "ofAxeFermo on", v["st"]["toll"] and abs(posit - quota) <= 5 and v["ofToll"] and v["ofAxeFermo"],
+           f"posit {posit}, states {v['st']}")
     report("epicpos: posit is the plant's position (1 count = 1 Um)", abs(posit - pos) <= 1,
            f"posit {posit}, plant {pos} counts")
     moving = [outs for (*_, outs, still) in samples if not still]
@@ -487,8 +502,8 @@ def t_emergency(m):
     moving = not m.coils(ST["still"])
     command(m, "EMRG")
     time.sleep(0.2)
-    s, dac = state(m), m.md(DACVAL)
-    x0 = m.sim(0)[0]
+    v = snap(m)
+    s, dac, x0 = v["st"], v["dacval"], v["x"]
     time.sleep(0.2)
     x1, v1 = m.sim(0)
     report("epicpos: EMRG command coil during a move: st_emrg on, loop open, DAC value 0, the axis stops",
@@ -509,30 +524,36 @@ def t_emergency(m):
            s["toll"] and abs(posit - quota) <= 5, f"posit {posit}, quota {quota}")
 
 
-def t_following_error(m):
+def t_following_error(m, port):
     """maxfollerr below the drive's lag error: st_foller and an emergency,
-    st_foller held 500 ms at least; RESUME and a START complete the move."""
+    st_foller held 500 ms at least (counted in cycles by a trace); RESUME
+    and a START complete the move."""
     settle(m)
     m.set_md(P["maxfollerr"], 5)
     base = m.md(POSIT)
     quota = base + 2500
+    rec = Recording(port, ["res0.axis.st_foller"], "res0.axis.st_foller:rise", 1500,
+                    os.path.join(WORK, "foller.csv"), pre=1)
     start_move(m, quota)
-    t_on = None
     s = wait_for(lambda: (lambda s: s if s["foller"] else None)(state(m)), 2.0, 0.005)
-    t_on = time.monotonic()
     if not s:
         report("epicpos: following error beyond maxfollerr (5 counts) sets st_foller", False, state(m))
         m.set_md(P["maxfollerr"], 10000)
+        rec.p.kill()
         return
     time.sleep(0.25)
-    s1, dac, (x1, v1) = state(m), m.md(DACVAL), m.sim(0)
+    v = snap(m)
+    s1, dac, x1, v1 = v["st"], v["dacval"], v["x"], v["v"]
     report("epicpos: following error beyond maxfollerr (5): st_foller, emergency, loop open, DAC 0, "
            "the axis stops", s1["foller"] and s1["emrg"] and not s1["loopon"] and dac == 0 and v1 == 0
            and x1 < quota - 1000, f"states {s1}, DAC {dac}, plant at {x1} ({v1} counts/s)")
-    off = wait_for(lambda: not m.coils(ST["foller"]), 3.0, 0.01)
-    held = time.monotonic() - t_on
-    report("epicpos: st_foller is held 500 ms at least, then clears (the error back within the limit)",
-           off and held >= 0.45, f"held {held:.2f} s")
+    rows = rec.rows()
+    on = [t for _, t, (f,) in rows if f]
+    off = next((t for _, t, (f,) in rows if not f and on and t > on[0]), None)
+    held = (off - on[0]) if off is not None else None
+    report("epicpos: st_foller is held 500 ms of PLC time at least, then clears "
+           "(the error back within the limit)", held is not None and held >= 500,
+           f"held {held:.0f} ms" if held is not None else f"not cleared within {len(rows)} samples")
     m.set_md(P["maxfollerr"], 10000)
     command(m, "RESUME")
     s, posit = move(m, quota, 8.0)
@@ -618,7 +639,7 @@ def t_bad_modbus(m, port):
     for name, ok, why in checks:
         report("epicpos: bad Modbus input during a move: " + name, ok, why)
     _, s = follow(m, 8.0)
-    posit, after = m.md(POSIT), params(m)
+    posit, after = snap(m)["posit"], params(m)
     after["slQuotaPos"] = before["slQuotaPos"] = 0
     report("epicpos: after the bad requests the move ends at the quota, no emergency, set-up unchanged",
            s["toll"] and not s["emrg"] and abs(posit - quota) <= 5 and after == before,
@@ -630,18 +651,20 @@ def t_readonly_values(m):
     """posit and the states are outputs of the program: writing them changes
     nothing the axis does (docs/examples.md: read only, rewritten every cycle)."""
     settle(m)
-    p0, x0 = m.md(POSIT), m.sim(0)[0]
-    r0 = m.md(REFCNT)
+    v = snap(m)
+    p0, x0, r0 = v["posit"], v["x"], v["refcnt"]
     m.set_md(POSIT, p0 + 50000)
     m.set_coil(ST["emrg"], 1)
     m.set_coil(ST["still"], 0)
     time.sleep(0.1)
-    p1, s = m.md(POSIT), state(m)
+    v = snap(m)
+    p1, s = v["posit"], v["st"]
     dx, dp = still_for(m, 0.3)
-    x1 = m.sim(0)[0]
+    v = snap(m)
+    x1 = v["x"]
     report("epicpos: writing posit and state coils: rewritten by the program, the axis does not move",
            abs(p1 - p0) <= 5 and not s["emrg"] and s["still"] and abs(x1 - x0) <= 5 and dp <= 5
-           and m.md(REFCNT) == r0, f"posit {p0} -> {p1}, states {s}, plant {x0} -> {x1}")
+           and v["refcnt"] == r0, f"posit {p0} -> {p1}, states {s}, plant {x0} -> {x1}")
 
 
 def t_posit_commands(m):
@@ -657,15 +680,18 @@ def t_posit_commands(m):
     time.sleep(0.05)
     p2 = m.md(POSIT)
     dx, _ = still_for(m, 0.2)
-    x1 = m.sim(0)[0]
+    v = snap(m)
+    x1 = v["x"]
     report("epicpos: WRPOSIT: posit := newposit (100000); DELCNT: posit + delta (-2345); the axis stays",
-           abs(p1 - 100000) <= 2 and p2 - p1 == -2345 and abs(x1 - x0) <= 5 and dx <= 5 and m.coils(ST["still"]),
+           abs(p1 - 100000) <= 2 and p2 - p1 == -2345 and abs(x1 - x0) <= 5 and dx <= 5 and v["st"]["still"],
            f"posit {p1}, then {p2}; plant {x0} -> {x1}")
+    p2, x1 = v["posit"], v["x"]         # posit and the plant of one cycle
     # a START goes to a quota in the new frame
     quota = p2 + 1000
     start_move(m, quota)
     _, s = follow(m, 6.0)
-    posit, x2 = m.md(POSIT), m.sim(0)[0]
+    v = snap(m)
+    posit, x2 = v["posit"], v["x"]
     report("epicpos: after WRPOSIT/DELCNT a START moves by the difference in the new frame",
            s["toll"] and abs(posit - quota) <= 5 and abs((x2 - x1) - (posit - p2)) <= 2,
            f"posit {p2} -> {posit} (quota {quota}), plant {x1} -> {x2}")
@@ -679,8 +705,8 @@ def t_calibration(m):
     command(m, "CALON")
     m.set_md(P["vout"], 10)                     # 1.0 V
     time.sleep(0.4)                             # 20 drive time constants
-    s, dac, vel = state(m), m.md(DACVAL), m.md(VEL)
-    xs, vs = m.sim(0)
+    v = snap(m)
+    s, dac, vel, xs, vs = v["st"], v["dacval"], v["vel"], v["x"], v["v"]
     want = 1.0 / 10 * SIM_MAXVEL
     report(f"epicpos: CALON with vout 10: st_cal, DAC 3277 (1 V), the plant at {want:.1f} counts/s, "
            f"vel {want * 60:.0f} Um/min", s["cal"] and abs(dac - 3276.7) <= 1 and abs(vs - want) <= 2
@@ -688,7 +714,8 @@ def t_calibration(m):
     m.set_md(P["vout"], 0)                      # back to 0 V while still calibrating
     command(m, "CALOFF")
     time.sleep(0.3)
-    s, x1 = state(m), m.sim(0)[0]
+    v = snap(m)
+    s, x1 = v["st"], v["x"]
     dx, dp = still_for(m, 0.3)
     report("epicpos: CALOFF: st_cal off, the axis stops where it is (no run back) and stays",
            not s["cal"] and s["still"] and x1 >= xs and dx <= 5 and dp <= 5 and not s["emrg"],
@@ -724,7 +751,7 @@ def main_session():
     run("epicpos: parameter range", t_param_range, m)
     run("epicpos: parameter beyond INT", t_param_beyond_int, m)
     run("epicpos: emergency", t_emergency, m)
-    run("epicpos: following error", t_following_error, m)
+    run("epicpos: following error", t_following_error, m, port)
     run("epicpos: command coils", t_command_coil, m)
     run("epicpos: bad Modbus input", t_bad_modbus, m, port)
     run("epicpos: read-only values", t_readonly_values, m)

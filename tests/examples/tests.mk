@@ -19,6 +19,7 @@ test-examples: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/multiaxis/plcrt $(BUILD)/
 	$(foreach e,$(EX_CAM),$(call EX_RUN,$(e)) || rc=1; )\
 	exit $$rc
 TESTS += test-examples
+STRESS_TESTS += test-examples
 MATIEC_TESTS += test-examples
 
 # Ctrl-C typed at `make run-epicpos` in a terminal (a pseudo-terminal): one
@@ -29,6 +30,7 @@ test-examples-ctrl-c: $(BUILD)/plc/epicpos/plcrt
 	@mk/suite.sh $(RESULTS) examples-ctrl-c python3 tests/examples/test_ctrl_c.py . \
 	    examples/epicpos/epicpos.ini $(abspath $(BUILD))/tests/ctrl-c
 TESTS += test-examples-ctrl-c
+STRESS_TESTS += test-examples-ctrl-c
 
 # The CAM examples alone (they are also in test-examples).
 .PHONY: test-examples-cam

@@ -13,4 +13,5 @@ test-getting-started: plcrt-parts
 	    python3 tests/getting_started/run_page.py \
 	    docs/getting-started.md . $(abspath $(GS_T))
 TESTS += test-getting-started
+STRESS_TESTS += test-getting-started
 MATIEC_TESTS += test-getting-started

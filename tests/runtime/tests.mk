@@ -69,6 +69,7 @@ test-runtime-integration: $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-clien
 	@mk/suite.sh $(RESULTS) runtime-integration python3 tests/runtime/test_plcrt.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(RT_T)/random-test-client auto $(abspath $(RT_T))/integration
 TESTS += test-runtime-integration
+STRESS_TESTS += test-runtime-integration
 MATIEC_TESTS += test-runtime-integration
 # overruns: a program made too slow over Modbus, counted as its own
 $(eval $(call plcrt_program,rt_spin,tests/runtime/st/spin.st))
@@ -77,6 +78,7 @@ test-runtime-overrun: $(BUILD)/plc/rt_spin/plcrt
 	@mk/suite.sh $(RESULTS) runtime-overrun python3 tests/runtime/test_overrun.py \
 	  $(BUILD)/plc/rt_spin/plcrt $(abspath $(RT_T))/overrun
 TESTS += test-runtime-overrun
+STRESS_TESTS += test-runtime-overrun
 # the configuration checked whole: --check-config and the start on
 # temporary files (docs/config.md)
 .PHONY: test-runtime-config
@@ -84,6 +86,7 @@ test-runtime-config: $(BUILD)/plc/rt_iotest/plcrt
 	@mk/suite.sh $(RESULTS) runtime-config python3 tests/runtime/test_config.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(abspath $(RT_T))/config
 TESTS += test-runtime-config
+STRESS_TESTS += test-runtime-config
 # the Modbus server against misbehaving clients, and the 1 ms scan under a
 # flood of them
 $(eval $(call plcrt_program,rt_fast,tests/runtime/st/fast.st))
@@ -92,6 +95,7 @@ test-runtime-mbserver: $(BUILD)/plc/rt_iotest/plcrt $(BUILD)/plc/rt_fast/plcrt
 	@mk/suite.sh $(RESULTS) runtime-mbserver python3 tests/runtime/test_mbserver.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(BUILD)/plc/rt_fast/plcrt $(abspath $(RT_T))/mbserver
 TESTS += test-runtime-mbserver
+STRESS_TESTS += test-runtime-mbserver
 # program instances named p, axis and res0: matiec's instance macros stay in
 # its resource file
 $(eval $(call plcrt_program,rt_names,tests/runtime/st/names.st))
@@ -99,6 +103,7 @@ $(eval $(call plcrt_program,rt_names,tests/runtime/st/names.st))
 test-runtime-names: $(BUILD)/plc/rt_names/plcrt
 	@mk/suite.sh $(RESULTS) runtime-names tests/runtime/names.sh $< $(RT_T)/names
 TESTS += test-runtime-names
+STRESS_TESTS += test-runtime-names
 MATIEC_TESTS += test-runtime-names
 # arrays, structures and block instances: retained, and exposed by IEC path
 $(eval $(call plcrt_program,rt_aggregates,tests/runtime/st/aggregates.st))
@@ -106,6 +111,7 @@ $(eval $(call plcrt_program,rt_aggregates,tests/runtime/st/aggregates.st))
 test-runtime-aggregates: $(BUILD)/plc/rt_aggregates/plcrt
 	@mk/suite.sh $(RESULTS) runtime-aggregates python3 tests/runtime/test_aggregates.py $< $(abspath $(RT_T))/aggregates
 TESTS += test-runtime-aggregates
+STRESS_TESTS += test-runtime-aggregates
 # the trace and forcing (docs/trace.md): plcrt on a program whose values
 # are functions of the cycle, the register block with pymodbus, plctrace
 $(eval $(call plcrt_program,rt_trace,tests/runtime/st/trace.st))
@@ -114,6 +120,7 @@ test-runtime-trace: $(BUILD)/plc/rt_trace/plcrt
 	@mk/suite.sh $(RESULTS) runtime-trace python3 tests/runtime/test_trace.py \
 	  $(BUILD)/plc/rt_trace/plcrt $(abspath $(RT_T))/trace
 TESTS += test-runtime-trace
+STRESS_TESTS += test-runtime-trace
 # every stop signal (SIGHUP, SIGQUIT too) the orderly way out, and a stop
 # asked for during the start-up before any cycle (docs/runtime.md)
 .PHONY: test-runtime-signals
@@ -121,6 +128,7 @@ test-runtime-signals: $(BUILD)/plc/rt_iotest/plcrt
 	@mk/suite.sh $(RESULTS) runtime-signals python3 tests/runtime/test_signals.py \
 	  $(BUILD)/plc/rt_iotest/plcrt $(abspath $(RT_T))/signals
 TESTS += test-runtime-signals
+STRESS_TESTS += test-runtime-signals
 MATIEC_TESTS += test-runtime-signals
 # the watchdog: a program that never returns puts the outputs in their safe
 # state and stops plcrt (status 3); long cycles do not trip it
@@ -129,6 +137,7 @@ test-runtime-watchdog: $(BUILD)/plc/rt_spin/plcrt
 	@mk/suite.sh $(RESULTS) runtime-watchdog python3 tests/runtime/test_watchdog.py \
 	  $(BUILD)/plc/rt_spin/plcrt $(abspath $(RT_T))/watchdog
 TESTS += test-runtime-watchdog
+STRESS_TESTS += test-runtime-watchdog
 # fuzzing what plcrt takes from outside while it runs (tests/fuzz/fuzz_plcrt.c):
 # Modbus requests into the map and the trace/forcing block with scan cycles
 # between them, and retain files behind a valid checksum. Briefly in `make
