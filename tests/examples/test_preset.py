@@ -24,9 +24,10 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from exlib import Mb, finish, ini_section, report, start_example, stop_and_exit_check, wait_for  # noqa: E402
+from onecycle import View  # noqa: E402
 
 PLCRT, INI, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
-RUN, PRSON, PRSOK = 0, 1, 2            # coils
+RUN = 0                                # coil
 PRSPOS, STATUS = 0, 10                 # %MD0; %MD10..15 mode, posit, count0..2, searches
 TOLL = 2                               # the program's toll
 SIM = ini_section(INI, "sim.axis0")
@@ -36,13 +37,20 @@ ZERO = ZOFF + ((CAM_LO - 1 - ZOFF) // CPR) * CPR      # the last zero pulse belo
 BANDS = {0: (CAM_LO - 10, CAM_LO - 1), 1: (ZERO - 1, ZERO - 1), 2: (CAM_HI - 25, CAM_HI)}
 
 
+# the status registers and the two state coils in one request (one cycle)
+PRG = "CONFIG0.RES0.PRESETS."
+VIEW = View([(n, PRG + n.upper(), "DINT") for n in ("mode", "posit", "count0", "count1", "count2", "searches")]
+            + [(n, PRG + n.upper(), "BOOL") for n in ("prson", "prsok")])
+
+
 def status(m):
-    mode, posit, c0, c1, c2, searches = m.md(STATUS, 6)
-    return {"mode": mode, "posit": posit, "count": [c0, c1, c2], "searches": searches}
+    v = VIEW.read(m.c)
+    return {"mode": v["mode"], "posit": v["posit"], "count": [v["count0"], v["count1"], v["count2"]],
+            "searches": v["searches"], "prson": bool(v["prson"]), "prsok": bool(v["prsok"])}
 
 
 def main():
-    p, port = start_example("preset", PLCRT, INI, WORK)
+    p, port = start_example("preset", PLCRT, INI, WORK, VIEW)
 
     def body():
         m = Mb(port)
@@ -56,15 +64,16 @@ def main():
         t0 = time.monotonic()
         while time.monotonic() - t0 < 25 and len(ends) < 3:
             s = status(m)
-            on, ok = m.coils(PRSON, 2)
-            if on:
+            if s["prson"]:
                 prson_seen.add(s["mode"])
             if s["searches"] > last["searches"]:
                 mode = last["mode"]
                 # the program waits 500 cycles after each search: the axis rests there
                 time.sleep(0.3)
-                on2, ok2 = m.coils(PRSON, 2)
-                ends[mode] = dict(status(m), prsok=ok and ok2, prson=on or on2)
+                s2 = status(m)
+                ends[mode] = dict(s2 if s2["searches"] == s["searches"] else s,
+                                  prsok=s["prsok"] and (s2["prsok"] or s2["searches"] != s["searches"]),
+                                  prson=s["prson"] or (s2["prson"] and s2["searches"] == s["searches"]))
             last = s
             time.sleep(0.005)
         report("preset: preset.ini's plant is the README's (cam 20000..22000, zero pulses at 1000 + 4000 k)",
