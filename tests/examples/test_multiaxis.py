@@ -96,9 +96,10 @@ def main():
             home.append(bool(at) and any(s["cur"] != i + 1 and abs(s["pos"][i]) <= TOLL for s, _ in log[at[0]:]))
         report("multiaxis: after the round of quotas each axis goes back to 0 within toll", all(home), home)
         seen = [(s["cur"], s["on"]) for s, _ in log]
-        onmatch = all(on[cur - 1] or not any(on) for cur, on in seen if 1 <= cur <= 3)
+        wrong = [(cur, on) for cur, on in seen if 1 <= cur <= 3 and any(on) and not on[cur - 1]]
         report("multiaxis: the axis on the DAC is the one being positioned, each in turn",
-               onmatch and {c for c, _ in seen} == {1, 2, 3}, str(seen[:: max(1, len(seen) // 20)]))
+               not wrong and {c for c, _ in seen} == {1, 2, 3},
+               f"current vs on: {wrong[:5]} of {len(seen)} samples; {seen[:: max(1, len(seen) // 20)]}")
         done = s1["moves"] - s0["moves"]
         report("multiaxis: positionings done increases (at least 4 in 5 s at 50000 Um/s)", done >= 4,
                f"{s0['moves']} -> {s1['moves']}")
