@@ -98,7 +98,7 @@ def main():
         seen = [(s["cur"], s["on"]) for s, _ in log]
         wrong = [(cur, on) for cur, on in seen if 1 <= cur <= 3 and any(on) and not on[cur - 1]]
         report("multiaxis: the axis on the DAC is the one being positioned, each in turn",
-               not wrong and {c for c, _ in seen} == {1, 2, 3},
+               not wrong and {c for c, _ in seen} - {0} == {1, 2, 3},       # 0: before the first cycle
                f"current vs on: {wrong[:5]} of {len(seen)} samples; {seen[:: max(1, len(seen) // 20)]}")
         done = s1["moves"] - s0["moves"]
         report("multiaxis: positionings done increases (at least 4 in 5 s at 50000 Um/s)", done >= 4,
