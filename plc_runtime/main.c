@@ -358,7 +358,7 @@ int main(int argc, char **argv)
 
     /* I/O */
     if (cfg.io->open(cfg.io_state, &plc_img, period, err, sizeof err)) {
-        fprintf(stderr, "plcrt: %s: backend %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", cfg.backend, err);
+        fprintf(stderr, "plcrt: %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", err);
         mb_server_stop(srv);
         return 2;
     }
@@ -387,7 +387,7 @@ int main(int argc, char **argv)
         if (cfg.allow_force) plc_log(LOG_WARN, "forcing allowed ([debug] allow_force)");
     }
     if (mb) {
-        uint16_t diag[MB_DIAG_N];
+        uint16_t diag[MB_DIAG_ALL];
         scan_diag(&sc, diag);
         mb_publish(mb, &plc_img, diag);
     }

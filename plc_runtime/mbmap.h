@@ -38,6 +38,9 @@
 #define MB_INPUT_IMG   1024    /* %IW */
 #define MB_DIAG_BASE   1024    /* input registers of diagnostics */
 #define MB_DIAG_N      128
+#define MB_IODIAG_BASE 20000   /* input registers of the I/O backends' diagnostics */
+#define MB_IODIAG_N    (IO_MULTI_MAX * IO_DIAG_BLOCK)   /* IO_DIAG_BLOCK per backend */
+#define MB_DIAG_ALL    (MB_DIAG_N + MB_IODIAG_N)        /* the diag array: both */
 #define MB_LOG_MAX     16384   /* pending writes: more than the writable cells */
 #define MB_PDU_MAX     253
 #define MB_TRACE_BASE  60000   /* holding registers of the trace block (tracemb.h) */
@@ -53,7 +56,7 @@ enum {
     MBD_EXCEPTIONS = 30, MBD_RETAIN_SAVES = 32, MBD_RETAIN_ERRORS = 34,
     MBD_IO_ERRORS = 36, MBD_UPTIME_S = 38, MBD_OVERRUNS_EXEC = 40,
     MBD_EVICTED = 42, MBD_DROPPED = 44, MBD_EXCHANGE_MAX = 46, MBD_FORCED = 48,
-    MBD_BACKEND = 64               /* 64 registers of the I/O backend */
+    MBD_BACKEND = 64               /* the first backend's first 64 registers */
 };
 
 typedef struct mb_item {           /* a program variable from the symbol map */
@@ -80,7 +83,7 @@ typedef struct mb_batch {          /* writes handed to the scan in one piece */
 
 typedef struct mb_snap {           /* what clients read: one cycle's image */
     plc_image img;
-    uint16_t diag[MB_DIAG_N];
+    uint16_t diag[MB_DIAG_ALL];
     uint64_t applied;              /* the last batch landed before it */
     uint8_t (*items)[8];           /* symbol values */
 } mb_snap;

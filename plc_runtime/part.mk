@@ -7,7 +7,7 @@ PLCRT_CFLAGS := $(CFLAGS) -I plc_runtime $(shell pkg-config --cflags libmodbus 2
 PLCRT_LIBS := -linih -lmodbus -lpthread -lm
 PLCRT_CORE := plc_image log stats config program mbmap mbserver retain scan \
               trace force tracemb \
-              io_none io_sim io_backends
+              io_none io_sim io_backends io_multi
 PLCRT_OBJ  := $(PLCRT_CORE:%=$(PLCRT_B)/%.o) $(C_BLOCKS_OBJ)
 include $(wildcard plc_runtime/canopen/part.mk)
 PLCRT_OBJ  += $(CO_BACKEND)

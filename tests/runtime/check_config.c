@@ -238,6 +238,37 @@ START_TEST(sim_master_follow)
 }
 END_TEST
 
+/* Several backends at once (docs/config.md [io]): each reads its own
+** sections; a bad list is refused naming the culprit. */
+START_TEST(several_backends)
+{
+    const char *t = "[io]\nbackend = none ,sim\n[sim.axis0]\ndac = %QW4\ncounter = %ID7\n";
+    ck_assert_msg(load(t) == 0, "%s", err);
+    ck_assert_str_eq(c.backend, "none, sim");
+    ck_assert_int_eq(io_multi_count(c.io_state), 2);
+    ck_assert_ptr_nonnull(io_multi_state(c.io_state, io_backend_find("sim")));
+    ck_assert_ptr_null(io_multi_state(c.io_state, io_backend_find("canopen")));
+    config_free(&c);
+    /* a section of the listed sim read by sim: its bad key refused */
+    ck_assert_int_ne(load("[io]\nbackend = none, sim\n[sim.axis0]\nnokey = 1\n"), 0);
+    ck_assert_msg(strstr(err, "[sim.axis0] nokey"), "%s", err);
+    config_free(&c);
+    static const struct { const char *v, *says; } bad[] = {
+        { "sim, sim", "backend sim listed twice" },
+        { "sim,", "may not end with a comma" },
+        { "sim,,none", "an empty name" },
+        { "sim, foo", "unknown backend 'foo'" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char txt[100];
+        snprintf(txt, sizeof txt, "[io]\nbackend = %s\n", bad[i].v);
+        ck_assert_int_ne(load(txt), 0);
+        ck_assert_msg(strstr(err, bad[i].says) && strstr(err, "[io] backend"), "%s: %s", bad[i].v, err);
+        config_free(&c);
+    }
+}
+END_TEST
+
 START_TEST(syntax)
 {
     bad("[plc]\nlog_level = info\nthis line has no equals sign\n", "plant.ini:3: syntax error");
@@ -674,6 +705,7 @@ int main(void)
     tcase_add_test(t, sim_modes_run);
     tcase_add_test(t, sim_master_markers);
     tcase_add_test(t, sim_master_follow);
+    tcase_add_test(t, several_backends);
     tcase_add_test(t, syntax);
     tcase_add_test(t, unknown);
     tcase_add_test(t, values);
