@@ -364,11 +364,11 @@ static const io_backend_ops *owner(const char *s)
 
 /* A backend's key given twice in a section (or in two sections of the same
 ** name) would silently replace the first: refused, naming the first line,
-** as for the runtime's own keys. `bind` ([canopen.NODE]) is the one key
-** meant to repeat. 1 when refused. */
+** as for the runtime's own keys. `bind` ([canopen.NODE]) and `read`,
+** `write` ([modbus_io.NAME]) are the keys meant to repeat. 1 when refused. */
 static int backend_twice(parse *p, const char *s, const char *key)
 {
-    if (!strcmp(key, "bind")) return 0;
+    if (!strcmp(key, "bind") || !strcmp(key, "read") || !strcmp(key, "write")) return 0;
     for (int i = 0; i < p->nseen; i++)
         if (!strncmp(p->seen[i].section, s, sizeof p->seen[i].section - 1)
             && !strncmp(p->seen[i].key, key, sizeof p->seen[i].key - 1)) {
