@@ -58,7 +58,7 @@ typedef struct parse {
 
 /* ---- the runtime's own keys ---------------------------------------------- */
 
-enum kind { K_INT, K_BOOL, K_STR, K_LOG, K_STATUS, K_BACKEND, K_BIND };
+enum kind { K_INT, K_BOOL, K_STR, K_LOG, K_STATUS, K_BACKEND, K_BIND, K_PARITY };
 #define F(x) offsetof(plc_config, x), sizeof ((plc_config *)0)->x
 static const struct key {
     const char *section, *key;
@@ -80,6 +80,12 @@ static const struct key {
     { "modbus", "port", K_INT, 1, 65535, F(mb_port) },
     { "modbus", "max_clients", K_INT, 1, 1000, F(mb_max_clients) },
     { "modbus", "idle_timeout", K_INT, 0, 86400, F(mb_idle_timeout) },
+    { "modbus_rtu", "device", K_STR, 0, 0, F(rtu_device) },
+    { "modbus_rtu", "baud", K_INT, 50, 4000000, F(rtu_baud) },
+    { "modbus_rtu", "parity", K_PARITY, 0, 0, F(rtu_parity) },
+    { "modbus_rtu", "data_bits", K_INT, 7, 8, F(rtu_data_bits) },
+    { "modbus_rtu", "stop_bits", K_INT, 1, 2, F(rtu_stop_bits) },
+    { "modbus_rtu", "slave", K_INT, 1, 247, F(rtu_slave) },
     { "retain", "file", K_STR, 0, 0, F(retain_file) },
     { "retain", "period", K_INT, 0, 86400, F(retain_period) },
     { "trace", "samples", K_INT, 16384, 1048576, F(trace_samples) },
@@ -268,6 +274,12 @@ static int own_key(parse *p, const char *s, const char *key, const char *v)
     case K_STR:
         if (get_str(v, f, k->size))
             return fail(p, s, key, "'%.40s...' is longer than %zu characters", v, k->size - 1);
+        return 1;
+    case K_PARITY:
+        if (!strcasecmp(v, "none")) c->rtu_parity = 'N';
+        else if (!strcasecmp(v, "even")) c->rtu_parity = 'E';
+        else if (!strcasecmp(v, "odd")) c->rtu_parity = 'O';
+        else return fail(p, s, key, "'%.60s' is not none, even or odd", v);
         return 1;
     case K_LOG:
         if ((c->log_level = plc_log_parse_level(v)) < 0)
@@ -594,6 +606,11 @@ int config_defaults(plc_config *c, char *err, size_t errlen)
     c->mb_port = 1502;
     c->mb_max_clients = 16;
     c->mb_idle_timeout = 10;
+    c->rtu_baud = 19200;
+    c->rtu_parity = 'E';
+    c->rtu_data_bits = 8;
+    c->rtu_stop_bits = 1;
+    c->rtu_slave = 1;
     strcpy(c->retain_file, "plcrt.retain");
     c->retain_period = 10;
     c->trace_samples = 16384;

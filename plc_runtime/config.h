@@ -21,7 +21,7 @@
 #define CFG_MAX_STATUS 8
 #define CFG_MAX_LINE 2048       /* characters in one line, newline excluded */
 #define CFG_MAX_FILE (1 << 20)  /* bytes in one file */
-#define CFG_NKEYS 18            /* keys of the runtime's own sections */
+#define CFG_NKEYS 24            /* keys of the runtime's own sections */
 
 enum { MB_COILS, MB_DISCRETE, MB_INPUT, MB_HOLDING };
 
@@ -58,6 +58,10 @@ typedef struct plc_config {
     int mb_port;
     int mb_max_clients;
     int mb_idle_timeout;                /* s, 0 = never */
+    /* [modbus_rtu]: the same map on a serial line */
+    char rtu_device[128];               /* "" = none */
+    int rtu_baud, rtu_data_bits, rtu_stop_bits, rtu_slave;
+    char rtu_parity;                    /* 'N', 'E', 'O' */
     cfg_symbol symbols[CFG_MAX_SYMBOLS];
     int nsymbols;
     /* [retain] */

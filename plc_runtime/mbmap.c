@@ -427,6 +427,7 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
     static const char *tabs[] = { "coil", "discrete input", "input register", "holding register" };
     mb_shared *m = calloc(1, sizeof *m);
     if (!m) { snprintf(err, errlen, "out of memory"); return NULL; }
+    pthread_mutex_init(&m->serve, NULL);
     m->front = 0; m->back = 2;
     atomic_init(&m->mid, 1u);
     m->fill = &m->batch[0];
@@ -483,6 +484,7 @@ void mb_free(mb_shared *m)
 {
     if (!m) return;
     for (int i = 0; i < 3; i++) free(m->snap[i].items);
+    pthread_mutex_destroy(&m->serve);
     free(m->items);
     free(m->item_idx);
     free(m);

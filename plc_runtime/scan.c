@@ -55,6 +55,8 @@ void scan_diag(scan *s, uint16_t *d)
         put32(d, MBD_EVICTED, LD(s->mb->evicted));
         put32(d, MBD_DROPPED, LD(s->mb->dropped));
         put32(d, MBD_EXCHANGE_MAX, LD(s->mb->exchange_max_ns) / 1000);
+        put32(d, MBD_RTU_SERVED, LD(s->mb->rtu_served));
+        put32(d, MBD_RTU_BAD, LD(s->mb->rtu_bad));
     }
     put32(d, MBD_RETAIN_SAVES, LD(s->retain_saves));
     put32(d, MBD_RETAIN_ERRORS, LD(s->retain_errors));

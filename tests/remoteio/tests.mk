@@ -17,3 +17,11 @@ test-remoteio: $(BUILD)/plc/rio_copy/plcrt $(RIO_T)/unit-test-server
 	@mk/suite.sh $(RESULTS) remoteio python3 tests/remoteio/test_remoteio.py \
 	  $(BUILD)/plc/rio_copy/plcrt $(RIO_T)/unit-test-server $(abspath $(RIO_T))/work
 TESTS += test-remoteio
+
+# plcrt's own map on a serial line ([modbus_rtu]): mbpoll -m rtu and
+# pymodbus over a socat pseudo-terminal pair, malformed frames
+.PHONY: test-rtuserver
+test-rtuserver: $(BUILD)/plc/rio_copy/plcrt
+	@mk/suite.sh $(RESULTS) rtuserver python3 tests/remoteio/test_rtuserver.py \
+	  $(BUILD)/plc/rio_copy/plcrt $(abspath $(RIO_T))/rtuserver
+TESTS += test-rtuserver
