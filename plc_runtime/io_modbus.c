@@ -203,11 +203,12 @@ static int block(dev *d, int write, const char *v, char *err, size_t n)
         return -1;
     }
     char want = write ? 'Q' : 'I';
-    if (b->loc.area != want) {
+    if (write ? b->loc.area != 'Q' : b->loc.area == 'Q') {
         snprintf(err, n, "'%s': a %s block goes to %s", s_loc, write ? "write" : "read",
-                 write ? "an output (%QX, %QW, %QD)" : "an input (%IX, %IW, %ID)");
+                 write ? "an output (%QX, %QW, %QD)" : "an input (%IX, %IW, %ID) or memory (%MX, %MW, %MD)");
         return -1;
     }
+    want = b->loc.area;
     if (bits && b->loc.size != 'X') {
         snprintf(err, n, "'%s': %ss are bits: give a %%%cX location", s_loc, tables[b->table], want);
         return -1;
@@ -347,11 +348,13 @@ static int rd(void *st, plc_image *img, uint64_t now)
                 uint8_t *p = plc_loc_ptr(img, &b->loc);
                 for (unsigned k = 0; k < b->count; k++) p[k] = (uint8_t)(x[k] != 0);
             } else if (b->loc.size == 'W') {
-                for (unsigned k = 0; k < b->count; k++) img_set16(img->iw, b->loc.index + k, (int16_t)x[k]);
+                uint8_t *p = plc_loc_ptr(img, &b->loc);
+                for (unsigned k = 0; k < b->count; k++) img_set16(p, k, (int16_t)x[k]);
             } else {
+                uint8_t *p = plc_loc_ptr(img, &b->loc);
                 for (unsigned k = 0; k < b->count; k += 2) {
                     uint32_t hi = d->low_first ? x[k + 1] : x[k], lo = d->low_first ? x[k] : x[k + 1];
-                    img_set32(img->id, b->loc.index + k / 2, (int32_t)(hi << 16 | lo));
+                    img_set32(p, k / 2, (int32_t)(hi << 16 | lo));
                 }
             }
         }
