@@ -27,7 +27,10 @@
 ** block, allocate or log at length (use the rate-limited plc_log). They
 ** only touch the image passed in. Errors found while running are reported
 ** through diag() (and may make read_inputs return -1 once per occurrence,
-** which the runtime counts and logs); they never stop the scan.
+** which the runtime counts and logs); they never stop the scan. A backend
+** whose devices are slow (a network, a serial line) talks to them in
+** threads of its own and trades whole buffers with read_inputs and
+** write_outputs through atomic swaps (io_modbus.c does so).
 **
 ** To add a backend: implement an io_backend_ops, and list it in
 ** io_backends.c.
@@ -38,8 +41,6 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "plc_image.h"
-
-#define IO_DIAG_MAX 64     /* registers a backend may publish over Modbus */
 
 /* One input a backend writes into the image, for io_inputs_apart: where,
 ** how many bytes, and its name for a message ("[sim.axis0] counter"). */
@@ -70,11 +71,13 @@ typedef struct io_backend_ops {
     /* Outputs to their safe state (see above). */
     void (*safe_state)(void *st, plc_image *img);
     void (*close)(void *st);
-    /* Copy up to max diagnostic registers (16-bit) into regs; return how
-    ** many. Called from the scan thread once per cycle. May be NULL. */
+    /* Copy up to max (IO_DIAG_BLOCK) diagnostic registers (16-bit) into
+    ** regs; return how many. Called from the scan thread once per cycle.
+    ** The first listed backend's first 64 are also served at input
+    ** registers 1088-1151 (docs/modbus.md). May be NULL. */
     size_t (*diag)(void *st, uint16_t *regs, size_t max);
-    /* After open(): up to max inputs the backend writes (see io_input_use
-    ** below) into out; return how many. May be NULL (writes no input). */
+    /* After open(): up to max inputs the backend writes (io_input_use
+    ** above) into out; return how many. May be NULL (writes no input). */
     int (*inputs)(void *st, plc_image *img, io_input_use *out, int max);
 } io_backend_ops;
 
