@@ -8,7 +8,7 @@ tank (Modbus RTU, slave 2, 38400 8N1 on the pseudo-terminal TTY): a level
   0-1, 32-bit, low word first), a pump (holding register 0: 1 = on); the
   flow counter as the PLC saw it comes back in holding registers 10-11.
 
-Prints one line a second. usage: modules.py TTY"""
+Prints one line a second. usage: modules.py TTY [PANEL_PORT]"""
 import asyncio
 import sys
 
@@ -26,15 +26,15 @@ def tables():
                               zero_mode=True)
 
 
-async def main(tty):
+async def main(tty, port):
     panel, tank = tables(), tables()
-    tcp = ModbusTcpServer(ModbusServerContext(slaves=panel, single=True), address=("127.0.0.1", 5020))
+    tcp = ModbusTcpServer(ModbusServerContext(slaves=panel, single=True), address=("127.0.0.1", port))
     rtu = ModbusSerialServer(ModbusServerContext(slaves={2: tank}, single=False), framer=ModbusRtuFramer,
                              port=tty, baudrate=38400, bytesize=8, parity="N", stopbits=1)
     asyncio.ensure_future(tcp.serve_forever())
     asyncio.ensure_future(rtu.serve_forever())
     level, flow, t = 500.0, 0, 0
-    print("modules: panel on 127.0.0.1:5020, tank (slave 2) on", tty, flush=True)
+    print(f"modules: panel on 127.0.0.1:{port}, tank (slave 2) on", tty, flush=True)
     while True:
         await asyncio.sleep(0.1)
         t += 1
@@ -52,4 +52,4 @@ async def main(tty):
 
 
 if __name__ == "__main__":
-    asyncio.run(main(sys.argv[1]))
+    asyncio.run(main(sys.argv[1], int(sys.argv[2]) if len(sys.argv) > 2 else 5020))

@@ -25,3 +25,11 @@ test-rtuserver: $(BUILD)/plc/rio_copy/plcrt
 	@mk/suite.sh $(RESULTS) rtuserver python3 tests/remoteio/test_rtuserver.py \
 	  $(BUILD)/plc/rio_copy/plcrt $(abspath $(RIO_T))/rtuserver
 TESTS += test-rtuserver
+
+# the example as a user runs it (make run-remoteio)
+.PHONY: test-remoteio-example
+test-remoteio-example: $(BUILD)/plc/remoteio/plcrt
+	@mk/suite.sh $(RESULTS) remoteio-example python3 tests/remoteio/test_example.py $(BUILD)/plc/remoteio/plcrt \
+	  $(abspath $(RIO_T))/example
+TESTS += test-remoteio-example
+MATIEC_TESTS += test-remoteio test-rtuserver test-remoteio-example
