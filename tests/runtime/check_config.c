@@ -316,6 +316,28 @@ START_TEST(modbus_io_keys)
 }
 END_TEST
 
+/* [modbus_rtu] (docs/config.md): the map on a serial line */
+START_TEST(modbus_rtu_keys)
+{
+    ck_assert_msg(load("[modbus_rtu]\ndevice = /dev/ttyS1\nbaud = 9600\nparity = none\nstop_bits = 2\nslave = 9\n") == 0,
+                  "%s", err);
+    ck_assert_str_eq(c.rtu_device, "/dev/ttyS1");
+    ck_assert_int_eq(c.rtu_baud, 9600);
+    ck_assert_int_eq(c.rtu_parity, 'N');
+    ck_assert_int_eq(c.rtu_stop_bits, 2);
+    ck_assert_int_eq(c.rtu_slave, 9);
+    config_free(&c);
+    ck_assert_int_eq(load(""), 0);
+    ck_assert_str_eq(c.rtu_device, "");                 /* off by default */
+    ck_assert_int_eq(c.rtu_parity, 'E');                /* Modbus's default */
+    config_free(&c);
+    bad("[modbus_rtu]\nparity = mark\n", "plant.ini:2: [modbus_rtu] parity: 'mark' is not none, even or odd");
+    bad("[modbus_rtu]\nslave = 0\n", "[modbus_rtu] slave");
+    bad("[modbus_rtu]\nbaud = 9600\nbaud = 19200\n", "given twice (first on line 2)");
+    bad("[modbus_rtu]\nspeed = 9600\n", "[modbus_rtu] speed: unknown key");
+}
+END_TEST
+
 START_TEST(syntax)
 {
     bad("[plc]\nlog_level = info\nthis line has no equals sign\n", "plant.ini:3: syntax error");
@@ -754,6 +776,7 @@ int main(void)
     tcase_add_test(t, sim_master_follow);
     tcase_add_test(t, several_backends);
     tcase_add_test(t, modbus_io_keys);
+    tcase_add_test(t, modbus_rtu_keys);
     tcase_add_test(t, syntax);
     tcase_add_test(t, unknown);
     tcase_add_test(t, values);
