@@ -19,6 +19,14 @@ bench-runtime: $(BUILD)/plc/bench_empty/plcrt $(BUILD)/plc/bench_empty250/plcrt 
 	  $(BENCH_B)/runtime/refserver $(BENCH_B)/runtime/mbload
 BENCHES += bench-runtime
 
+# remote I/O: modbus_io polling 1, 10, 32 devices beside a plain libmodbus
+# client loop, input age at the scan, scan cost with and without it
+.PHONY: bench-remoteio
+bench-remoteio: $(BUILD)/plc/bench_empty/plcrt $(BENCH_B)/runtime/refserver $(BENCH_B)/runtime/mbloop
+	python3 bench/runtime/remoteio_bench.py $(BUILD)/plc/bench_empty/plcrt $(BENCH_B)/runtime/refserver \
+	  $(BENCH_B)/runtime/mbloop $(abspath $(BENCH_B))/remoteio
+BENCHES += bench-remoteio
+
 # EPICPOS: instructions and ns per call, per scan with 1, 16 and 256 axes,
 # and the most axes plcrt runs at 1 ms with no overrun (bench/epicpos/)
 .PHONY: bench-epicpos

@@ -21,3 +21,9 @@ ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 $(EXAMPLES:%=run-%): run-%: $(BUILD)/plc/%/plcrt
 	@mk/run_fg.sh $(BUILD)/plc/$*/plcrt -c $(or $(INI),examples/$*/$*.ini)
 RUN_DEMO := run-epicpos
+# remote I/O (docs/remote-io.md): two pymodbus modules beside plcrt
+$(eval $(call plcrt_program,remoteio,examples/remoteio/remoteio.st))
+ALL += $(BUILD)/plc/remoteio/plcrt
+.PHONY: run-remoteio
+run-remoteio: $(BUILD)/plc/remoteio/plcrt
+	@examples/remoteio/run.sh $(BUILD)/plc/remoteio/plcrt $(INI)

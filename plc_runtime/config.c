@@ -58,7 +58,7 @@ typedef struct parse {
 
 /* ---- the runtime's own keys ---------------------------------------------- */
 
-enum kind { K_INT, K_BOOL, K_STR, K_LOG, K_STATUS, K_BACKEND, K_BIND };
+enum kind { K_INT, K_BOOL, K_STR, K_LOG, K_STATUS, K_BACKEND, K_BIND, K_PARITY };
 #define F(x) offsetof(plc_config, x), sizeof ((plc_config *)0)->x
 static const struct key {
     const char *section, *key;
@@ -80,6 +80,12 @@ static const struct key {
     { "modbus", "port", K_INT, 1, 65535, F(mb_port) },
     { "modbus", "max_clients", K_INT, 1, 1000, F(mb_max_clients) },
     { "modbus", "idle_timeout", K_INT, 0, 86400, F(mb_idle_timeout) },
+    { "modbus_rtu", "device", K_STR, 0, 0, F(rtu_device) },
+    { "modbus_rtu", "baud", K_INT, 50, 4000000, F(rtu_baud) },
+    { "modbus_rtu", "parity", K_PARITY, 0, 0, F(rtu_parity) },
+    { "modbus_rtu", "data_bits", K_INT, 7, 8, F(rtu_data_bits) },
+    { "modbus_rtu", "stop_bits", K_INT, 1, 2, F(rtu_stop_bits) },
+    { "modbus_rtu", "slave", K_INT, 1, 247, F(rtu_slave) },
     { "retain", "file", K_STR, 0, 0, F(retain_file) },
     { "retain", "period", K_INT, 0, 86400, F(retain_period) },
     { "trace", "samples", K_INT, 16384, 1048576, F(trace_samples) },
@@ -269,6 +275,12 @@ static int own_key(parse *p, const char *s, const char *key, const char *v)
         if (get_str(v, f, k->size))
             return fail(p, s, key, "'%.40s...' is longer than %zu characters", v, k->size - 1);
         return 1;
+    case K_PARITY:
+        if (!strcasecmp(v, "none")) c->rtu_parity = 'N';
+        else if (!strcasecmp(v, "even")) c->rtu_parity = 'E';
+        else if (!strcasecmp(v, "odd")) c->rtu_parity = 'O';
+        else return fail(p, s, key, "'%.60s' is not none, even or odd", v);
+        return 1;
     case K_LOG:
         if ((c->log_level = plc_log_parse_level(v)) < 0)
             return fail(p, s, key, "'%.60s' is not error, warning, info or debug", v);
@@ -281,16 +293,41 @@ static int own_key(parse *p, const char *s, const char *key, const char *v)
         if (!only(v, "0123456789.") && get_str(v, c->mb_bind_name, sizeof c->mb_bind_name))
             return fail(p, s, key, "host name longer than %zu characters", sizeof c->mb_bind_name - 1);
         return 1;
-    case K_BACKEND:
-        if (!io_backend_find(v)) {
-            char names[200] = "";
-            for (int j = 0; io_backends[j]; j++)
-                snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
-                         j ? ", " : "", io_backends[j]->name);
-            return fail(p, s, key, "unknown backend '%.40s' (known: %s)", v, names);
+    case K_BACKEND: {
+        /* one name or several, separated by commas: "sim, modbus_io" */
+        char list[256] = "", one[64];
+        const char *q = v;
+        int count = 0;
+        while (*q) {
+            size_t l = strcspn(q, ",");
+            const char *a = q, *b = q + l;
+            while (a < b && isspace((unsigned char)*a)) a++;
+            while (b > a && isspace((unsigned char)b[-1])) b--;
+            if (b == a) return fail(p, s, key, "'%.60s': an empty name in the list (NAME or NAME, NAME, ...)", v);
+            snprintf(one, sizeof one, "%.*s", (int)(b - a < 63 ? b - a : 63), a);
+            const io_backend_ops *o = io_backend_find(one);
+            if (!o) {
+                char names[200] = "";
+                for (int j = 0; io_backends[j]; j++)
+                    snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
+                             j ? ", " : "", io_backends[j]->name);
+                return fail(p, s, key, "unknown backend '%.40s' (known: %s)", one, names);
+            }
+            for (const char *w = list; *w; w += strcspn(w, ",") , w += *w ? 2 : 0)
+                if (!strncmp(w, one, strlen(one)) && (w[strlen(one)] == ',' || !w[strlen(one)]))
+                    return fail(p, s, key, "backend %s listed twice", one);
+            if (++count > IO_MULTI_MAX) return fail(p, s, key, "more than %d backends", IO_MULTI_MAX);
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", one);
+            q += l;
+            if (*q == ',') {
+                q++;
+                if (!*q) return fail(p, s, key, "'%.60s': a list may not end with a comma", v);
+            }
         }
-        if (get_str(v, f, k->size)) return fail(p, s, key, "too long");   /* never: found above */
+        if (!count) return fail(p, s, key, "empty: name a backend (none, sim, ...)");
+        if (get_str(list, f, k->size)) return fail(p, s, key, "list too long");
         return 1;
+    }
     }
     return fail(p, s, key, "unknown key");
 }
@@ -339,11 +376,11 @@ static const io_backend_ops *owner(const char *s)
 
 /* A backend's key given twice in a section (or in two sections of the same
 ** name) would silently replace the first: refused, naming the first line,
-** as for the runtime's own keys. `bind` ([canopen.NODE]) is the one key
-** meant to repeat. 1 when refused. */
+** as for the runtime's own keys. `bind` ([canopen.NODE]) and `read`,
+** `write` ([modbus_io.NAME]) are the keys meant to repeat. 1 when refused. */
 static int backend_twice(parse *p, const char *s, const char *key)
 {
-    if (!strcmp(key, "bind")) return 0;
+    if (!strcmp(key, "bind") || !strcmp(key, "read") || !strcmp(key, "write")) return 0;
     for (int i = 0; i < p->nseen; i++)
         if (!strncmp(p->seen[i].section, s, sizeof p->seen[i].section - 1)
             && !strncmp(p->seen[i].key, key, sizeof p->seen[i].key - 1)) {
@@ -372,10 +409,10 @@ static int handler(void *user, const char *s, const char *key, const char *v)
     if (p->pass == 1) return 1;
     const io_backend_ops *o = owner(s);
     if (!o) return fail(p, s, key, "unknown section");
-    if (o != c->io) return 1;                  /* another backend's: ignored */
+    if (!io_multi_state(c->io_state, o)) return 1;   /* a backend not listed: ignored */
     if (backend_twice(p, s, key)) return 0;
     char e[300] = "";
-    if (o->config(c->io_state, s, key, v, e, sizeof e))
+    if (o->config(io_multi_state(c->io_state, o), s, key, v, e, sizeof e))
         return fail(p, s, key, "%s", e[0] ? e : "rejected");
     return 1;
 }
@@ -502,6 +539,26 @@ static char *reader(char *buf, int n, void *stream)
     return buf;
 }
 
+/* The backends of c->backend (a checked list), created anew. 0, or -1 on
+** out of memory. */
+static int make_set(plc_config *c)
+{
+    if (c->io_state) c->io->close(c->io_state);
+    c->io = &io_multi;
+    c->io_list[0] = 0;
+    if (!(c->io_state = io_multi_new())) return -1;
+    char one[64];
+    for (const char *q = c->backend; *q;) {
+        size_t l = strcspn(q, ",");
+        snprintf(one, sizeof one, "%.*s", (int)(l < 63 ? l : 63), q);
+        if (!io_multi_add(c->io_state, io_backend_find(one))) return -1;
+        q += l;
+        while (*q == ',' || *q == ' ') q++;
+    }
+    snprintf(c->io_list, sizeof c->io_list, "%s", c->backend);
+    return 0;
+}
+
 static int run(plc_config *c, const char *name, const char *text, char *err, size_t errlen)
 {
     if (!strncmp(text, "\xEF\xBB\xBF", 3)) text += 3;     /* UTF-8 byte order mark */
@@ -512,16 +569,9 @@ static int run(plc_config *c, const char *name, const char *text, char *err, siz
     for (int pass = 1; pass <= 2; pass++) {
         memset(&p, 0, sizeof p);
         p.c = c; p.name = name; p.pass = pass; p.pos = text;
-        if (pass == 2) {
-            const io_backend_ops *io = io_backend_find(c->backend);
-            if (io != c->io) {
-                if (c->io) c->io->close(c->io_state);
-                c->io = io;
-                if (!(c->io_state = io->create())) {
-                    snprintf(err, errlen, "%s: backend %s: out of memory", name, io->name);
-                    return -1;
-                }
-            }
+        if (pass == 2 && strcmp(c->backend, c->io_list) && make_set(c)) {
+            snprintf(err, errlen, "%s: backend %s: out of memory", name, c->backend);
+            return -1;
         }
         int r = ini_parse_stream(reader, &p, handler, &p);
         if (r < 0) { snprintf(err, errlen, "%s: cannot read", name); return -1; }
@@ -556,11 +606,15 @@ int config_defaults(plc_config *c, char *err, size_t errlen)
     c->mb_port = 1502;
     c->mb_max_clients = 16;
     c->mb_idle_timeout = 10;
+    c->rtu_baud = 19200;
+    c->rtu_parity = 'E';
+    c->rtu_data_bits = 8;
+    c->rtu_stop_bits = 1;
+    c->rtu_slave = 1;
     strcpy(c->retain_file, "plcrt.retain");
     c->retain_period = 10;
     c->trace_samples = 16384;
-    c->io = io_backend_find(c->backend);
-    if (!(c->io_state = c->io->create())) {
+    if (make_set(c)) {
         snprintf(err, errlen, "out of memory");
         return -1;
     }

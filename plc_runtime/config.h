@@ -1,9 +1,9 @@
 /*
 ** config.h: the INI configuration (libinih). Every key, its default and
 ** meaning are documented in docs/config.md. Sections that belong to an I/O
-** backend ([sim], [sim.axis0], [canopen...]) are handed to the selected
-** backend; sections of other known backends are ignored, so switching
-** backend is one key; anything else is an error.
+** backend ([sim], [sim.axis0], [canopen...]) are handed to that backend
+** when `[io] backend` lists it; sections of other known backends are
+** ignored, so switching backend is one key; anything else is an error.
 **
 ** The file is checked whole, in three steps that all name file, line,
 ** section and key: config_load (syntax, every value; host names in
@@ -21,7 +21,7 @@
 #define CFG_MAX_STATUS 8
 #define CFG_MAX_LINE 2048       /* characters in one line, newline excluded */
 #define CFG_MAX_FILE (1 << 20)  /* bytes in one file */
-#define CFG_NKEYS 18            /* keys of the runtime's own sections */
+#define CFG_NKEYS 24            /* keys of the runtime's own sections */
 
 enum { MB_COILS, MB_DISCRETE, MB_INPUT, MB_HOLDING };
 
@@ -47,9 +47,10 @@ typedef struct plc_config {
     int overrun_log_interval;           /* s */
     int watchdog_ms;                    /* one cycle's program at most; 0 = off */
     /* [io] */
-    char backend[32];
-    const io_backend_ops *io;
+    char backend[128];                  /* "sim" or "sim, modbus_io" */
+    const io_backend_ops *io;           /* io_multi, over the listed ones */
     void *io_state;                     /* created during parsing */
+    char io_list[128];                  /* the backends io_state holds */
     /* [modbus] */
     int mb_enabled;
     char mb_bind[64];                   /* dotted IPv4 (host names resolved) */
@@ -57,6 +58,10 @@ typedef struct plc_config {
     int mb_port;
     int mb_max_clients;
     int mb_idle_timeout;                /* s, 0 = never */
+    /* [modbus_rtu]: the same map on a serial line */
+    char rtu_device[128];               /* "" = none */
+    int rtu_baud, rtu_data_bits, rtu_stop_bits, rtu_slave;
+    char rtu_parity;                    /* 'N', 'E', 'O' */
     cfg_symbol symbols[CFG_MAX_SYMBOLS];
     int nsymbols;
     /* [retain] */

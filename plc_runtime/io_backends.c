@@ -4,9 +4,9 @@
 #include <string.h>
 #include "io_backend.h"
 
-extern const io_backend_ops io_none, io_sim, io_canopen;
+extern const io_backend_ops io_none, io_sim, io_canopen, io_modbus;
 
-const io_backend_ops *const io_backends[] = { &io_none, &io_sim, &io_canopen, NULL };
+const io_backend_ops *const io_backends[] = { &io_none, &io_sim, &io_canopen, &io_modbus, NULL };
 
 const io_backend_ops *io_backend_find(const char *name)
 {

@@ -14,5 +14,5 @@ static void safe(void *st, plc_image *img) { (void)st; (void)img; }
 static void close_(void *st) { free(st); }
 
 const io_backend_ops io_none = {
-    "none", create, config, open_, rd, wr, safe, close_, NULL
+    "none", create, config, open_, rd, wr, safe, close_, NULL, NULL
 };

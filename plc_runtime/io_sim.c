@@ -243,30 +243,36 @@ static int config(void *st, const char *sec, const char *key, const char *v, cha
 ** axes copied from one section, say, would both write one counter and each
 ** position loop would follow the other's encoder. (Two axes may read one
 ** DAC: two drives on one speed reference.) 0, or -1 naming both. */
-static int inputs_apart(sim *s, plc_image *img, char *err, size_t n)
+static int list_inputs(void *st, plc_image *img, io_input_use *in, int max)
 {
-    io_input_use in[SIM_AXES * NBIND + 1 + SIM_MARKERS * NMBIND];
+    sim *s = st;
     int k = 0;
     for (int i = 0; i < SIM_AXES; i++)
         for (int b = B_COUNTER; b < NBIND && s->ax[i].used; b++)
-            if (s->ax[i].bound[b]) {
+            if (s->ax[i].bound[b] && k < max) {
                 in[k].p = plc_loc_ptr(img, &s->ax[i].loc[b]);
                 in[k].w = plc_loc_width(&s->ax[i].loc[b]);
                 snprintf(in[k++].who, sizeof in[0].who, "[sim.axis%d] %s", i, bind_keys[b]);
             }
-    if (s->master.used && s->master.bound) {
+    if (s->master.used && s->master.bound && k < max) {
         in[k].p = plc_loc_ptr(img, &s->master.loc);
         in[k].w = plc_loc_width(&s->master.loc);
         snprintf(in[k++].who, sizeof in[0].who, "[sim.master] counter");
     }
     for (int i = 0; i < SIM_MARKERS; i++)
         for (int b = 0; b < NMBIND && s->mk[i].used; b++)
-            if (s->mk[i].bound[b]) {
+            if (s->mk[i].bound[b] && k < max) {
                 in[k].p = plc_loc_ptr(img, &s->mk[i].loc[b]);
                 in[k].w = plc_loc_width(&s->mk[i].loc[b]);
                 snprintf(in[k++].who, sizeof in[0].who, "[sim.marker%d] %s", i, mbind_keys[b]);
             }
-    return io_inputs_apart(in, k, err, n);
+    return k;
+}
+
+static int inputs_apart(sim *s, plc_image *img, char *err, size_t n)
+{
+    io_input_use in[SIM_AXES * NBIND + 1 + SIM_MARKERS * NMBIND];
+    return io_inputs_apart(in, list_inputs(s, img, in, (int)(sizeof in / sizeof in[0])), err, n);
 }
 
 static int open_(void *st, plc_image *img, uint64_t tick, char *err, size_t n)
@@ -405,5 +411,5 @@ static size_t diag(void *st, uint16_t *r, size_t max)
 }
 
 const io_backend_ops io_sim = {
-    "sim", create, config, open_, rd, wr, safe, close_, diag
+    "sim", create, config, open_, rd, wr, safe, close_, diag, list_inputs
 };

@@ -22,6 +22,7 @@
 #include "log.h"
 #include "mbmap.h"
 #include "mbserver.h"
+#include "mbrtu.h"
 #include "program.h"
 #include "retain.h"
 #include "scan.h"
@@ -146,7 +147,7 @@ static int configure(plc_config *cfg, const char *file, const plc_program *prog,
         fprintf(stderr, "plcrt: %s\n", err);
         return 2;
     }
-    if (!cfg->mb_enabled) {                 /* checked, not served */
+    if (!cfg->mb_enabled && !cfg->rtu_device[0]) {     /* checked, not served */
         mb_free(*mb);
         *mb = NULL;
     }
@@ -165,6 +166,16 @@ static int configure(plc_config *cfg, const char *file, const plc_program *prog,
 ** lands in them after that. Save, release, and say so in one line; after
 ** SIGTERM (a service manager, a test) the statistics are printed too, after
 ** Ctrl-C (SIGINT, a person at the terminal) only that line. */
+/* The Modbus servers, TCP (srv, may be NULL) and RTU: stopped, a request
+** being served answered first. */
+static mb_rtu *rtu_srv;
+static void servers_stop(mb_server *srv)
+{
+    mb_server_stop(srv);
+    mb_rtu_stop(rtu_srv);
+    rtu_srv = NULL;
+}
+
 /* Once the scan no longer touches them: the image's outputs zeroed, the
 ** backend's physical outputs to their safe state (0 V, off). */
 static void outputs_safe(plc_config *cfg)
@@ -182,7 +193,7 @@ static void shut_down(scan *sc, pthread_t th, mb_server *srv, mb_shared *mb, plc
 {
     atomic_store(&sc->stop, 1);
     pthread_join(th, NULL);
-    mb_server_stop(srv);
+    servers_stop(srv);
     if (mb) mb_drain(mb, &plc_img);
     outputs_safe(cfg);
     uint64_t errs = atomic_load(&sc->retain_errors);
@@ -262,7 +273,7 @@ static _Noreturn void watchdog_halt(scan *sc, mb_server *srv, plc_config *cfg)
     plc_log(LOG_ERROR, "watchdog: the program has been running for %.0f ms in one cycle, beyond [scan] watchdog_ms "
             "= %d (an endless loop? a loop bound from a variable?): outputs to their safe state, plcrt stops",
             ms, cfg->watchdog_ms);
-    mb_server_stop(srv);
+    servers_stop(srv);
     outputs_safe(cfg);
     if (!cfg->retain_file[0])
         fprintf(stderr, "plcrt: stopped by the watchdog: outputs safe (DAC 0 V), nothing retained\n");
@@ -347,7 +358,7 @@ int main(int argc, char **argv)
     ** configuration stops here, before its backend could reset the nodes
     ** the first one drives */
     mb_server *srv = NULL;
-    if (mb && !(srv = mb_server_listen(&cfg, mb, err, sizeof err))) {
+    if (mb && cfg.mb_enabled && !(srv = mb_server_listen(&cfg, mb, err, sizeof err))) {
         int e = errno;
         char msg[800];
         config_msg(&cfg, "modbus", e == EADDRINUSE || e == EACCES ? "port" : "bind", msg, sizeof msg, "%s%s", err,
@@ -356,10 +367,19 @@ int main(int argc, char **argv)
         return 2;
     }
 
+    /* the serial line of [modbus_rtu], also before any I/O */
+    if (mb && cfg.rtu_device[0] && !(rtu_srv = mb_rtu_open(&cfg, mb, err, sizeof err))) {
+        char msg[800];
+        config_msg(&cfg, "modbus_rtu", "device", msg, sizeof msg, "%s", err);
+        fprintf(stderr, "plcrt: %s\n", msg);
+        servers_stop(srv);
+        return 2;
+    }
+
     /* I/O */
     if (cfg.io->open(cfg.io_state, &plc_img, period, err, sizeof err)) {
-        fprintf(stderr, "plcrt: %s: backend %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", cfg.backend, err);
-        mb_server_stop(srv);
+        fprintf(stderr, "plcrt: %s: %s\n", cfg.file[0] ? cfg.file : "(defaults)", err);
+        servers_stop(srv);
         return 2;
     }
 
@@ -387,7 +407,7 @@ int main(int argc, char **argv)
         if (cfg.allow_force) plc_log(LOG_WARN, "forcing allowed ([debug] allow_force)");
     }
     if (mb) {
-        uint16_t diag[MB_DIAG_N];
+        uint16_t diag[MB_DIAG_ALL];
         scan_diag(&sc, diag);
         mb_publish(mb, &plc_img, diag);
     }
@@ -397,16 +417,16 @@ int main(int argc, char **argv)
     ** mb_server_run on, a stop takes the orderly way, writes landed) */
     int early = stop_pending(&sigs);
     if (early) {
-        mb_server_stop(srv);
+        servers_stop(srv);
         cfg.io->safe_state(cfg.io_state, &plc_img);
         cfg.io->close(cfg.io_state);
         fprintf(stderr, "plcrt: %s during the start-up: stopped before the first cycle, outputs safe (DAC 0 V), "
                 "retain file untouched\n", sig_name(early));
         return 0;
     }
-    if (srv && mb_server_run(srv, err, sizeof err)) {
+    if ((srv && mb_server_run(srv, err, sizeof err)) || (rtu_srv && mb_rtu_run(rtu_srv, err, sizeof err))) {
         fprintf(stderr, "plcrt: %s\n", err);
-        mb_server_stop(srv);
+        servers_stop(srv);
         cfg.io->safe_state(cfg.io_state, &plc_img);
         cfg.io->close(cfg.io_state);
         return 1;

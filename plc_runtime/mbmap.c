@@ -56,6 +56,10 @@ static int resolve(mb_shared *m, int table, unsigned a, cell *c)
             *c = (cell){ (uint8_t *)&m->snap[m->front].diag[a - MB_DIAG_BASE], 2, 1, 0, 0, 0, 0 };
             return 0;
         }
+        if (a >= MB_IODIAG_BASE && a < MB_IODIAG_BASE + MB_IODIAG_N) {
+            *c = (cell){ (uint8_t *)&m->snap[m->front].diag[MB_DIAG_N + a - MB_IODIAG_BASE], 2, 1, 0, 0, 0, 0 };
+            return 0;
+        }
         break;
     case MB_HOLDING:
         if (a < 1024) { img_cell(m, s->qw + 2 * a, 2, 1, 0, 1, c); return 0; }
@@ -423,6 +427,7 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
     static const char *tabs[] = { "coil", "discrete input", "input register", "holding register" };
     mb_shared *m = calloc(1, sizeof *m);
     if (!m) { snprintf(err, errlen, "out of memory"); return NULL; }
+    pthread_mutex_init(&m->serve, NULL);
     m->front = 0; m->back = 2;
     atomic_init(&m->mid, 1u);
     m->fill = &m->batch[0];
@@ -459,6 +464,9 @@ mb_shared *mb_new(const plc_config *c, const plc_program *p, char *err, size_t e
         if (it->addr < fixed_end(it->table))
             FAIL("%s %u lies inside the fixed map (0..%u)", tabs[it->table], it->addr, fixed_end(it->table) - 1);
         if (it->addr + it->nregs > 65536) FAIL("does not fit below address 65536");
+        if (it->table == MB_INPUT && it->addr < MB_IODIAG_BASE + MB_IODIAG_N && it->addr + it->nregs > MB_IODIAG_BASE)
+            FAIL("input registers %d..%d are the I/O backends' diagnostics (docs/modbus.md)", MB_IODIAG_BASE,
+                 MB_IODIAG_BASE + MB_IODIAG_N - 1);
         if (it->table == MB_HOLDING && it->addr < MB_TRACE_END && it->addr + it->nregs > MB_TRACE_BASE)
             FAIL("holding registers %d..%d are the trace block (docs/trace.md)", MB_TRACE_BASE, MB_TRACE_END - 1);
         for (int j = 0; j < i; j++) {
@@ -476,6 +484,7 @@ void mb_free(mb_shared *m)
 {
     if (!m) return;
     for (int i = 0; i < 3; i++) free(m->snap[i].items);
+    pthread_mutex_destroy(&m->serve);
     free(m->items);
     free(m->item_idx);
     free(m);

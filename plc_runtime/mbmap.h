@@ -19,13 +19,15 @@
 **   scan took the previous one in; at the start of a cycle the scan lands
 **   the batch handed to it, whole (mb_apply).
 **
-** Threads: mb_process and mb_flush belong to one server thread; mb_apply
-** and mb_publish to the scan; mb_drain to the main thread once both
-** stopped. The counters are read by anyone.
+** Threads: mb_process and mb_flush belong to the server threads (TCP, and
+** RTU on a serial line), one at a time: each holds `serve` around them
+** (the scan never takes it); mb_apply and mb_publish to the scan; mb_drain
+** to the main thread once all stopped. The counters are read by anyone.
 */
 #ifndef MBMAP_H
 #define MBMAP_H
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -38,6 +40,9 @@
 #define MB_INPUT_IMG   1024    /* %IW */
 #define MB_DIAG_BASE   1024    /* input registers of diagnostics */
 #define MB_DIAG_N      128
+#define MB_IODIAG_BASE 20000   /* input registers of the I/O backends' diagnostics */
+#define MB_IODIAG_N    (IO_MULTI_MAX * IO_DIAG_BLOCK)   /* IO_DIAG_BLOCK per backend */
+#define MB_DIAG_ALL    (MB_DIAG_N + MB_IODIAG_N)        /* the diag array: both */
 #define MB_LOG_MAX     16384   /* pending writes: more than the writable cells */
 #define MB_PDU_MAX     253
 #define MB_TRACE_BASE  60000   /* holding registers of the trace block (tracemb.h) */
@@ -53,7 +58,8 @@ enum {
     MBD_EXCEPTIONS = 30, MBD_RETAIN_SAVES = 32, MBD_RETAIN_ERRORS = 34,
     MBD_IO_ERRORS = 36, MBD_UPTIME_S = 38, MBD_OVERRUNS_EXEC = 40,
     MBD_EVICTED = 42, MBD_DROPPED = 44, MBD_EXCHANGE_MAX = 46, MBD_FORCED = 48,
-    MBD_BACKEND = 64               /* 64 registers of the I/O backend */
+    MBD_RTU_SERVED = 50, MBD_RTU_BAD = 52,
+    MBD_BACKEND = 64               /* the first backend's first 64 registers */
 };
 
 typedef struct mb_item {           /* a program variable from the symbol map */
@@ -80,7 +86,7 @@ typedef struct mb_batch {          /* writes handed to the scan in one piece */
 
 typedef struct mb_snap {           /* what clients read: one cycle's image */
     plc_image img;
-    uint16_t diag[MB_DIAG_N];
+    uint16_t diag[MB_DIAG_ALL];
     uint64_t applied;              /* the last batch landed before it */
     uint8_t (*items)[8];           /* symbol values */
 } mb_snap;
@@ -97,6 +103,7 @@ typedef struct mb_block {
 #define MB_FRESH 4u                /* in mid: the middle snapshot is newer */
 
 typedef struct mb_shared {
+    pthread_mutex_t serve;         /* between the server threads only */
     mb_item *items;
     size_t nitems;
     mb_block block;                /* touches NULL: none */
@@ -114,6 +121,7 @@ typedef struct mb_shared {
     uint32_t img_idx[sizeof(plc_image)];   /* server's: image offset -> record + 1 in *fill */
     uint32_t *item_idx;                    /* item -> record + 1 */
     _Atomic uint64_t requests, exceptions, clients, refused, evicted, dropped;
+    _Atomic uint64_t rtu_served, rtu_bad;  /* the RTU server's (mbrtu.h) */
     _Atomic uint64_t exchange_max_ns;      /* scan's longest mb_apply + mb_publish */
 } mb_shared;
 

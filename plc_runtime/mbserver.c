@@ -89,7 +89,9 @@ static int serve_frames(mb_server *s, client *c, uint64_t now)
         if (c->nin - at < 6 + len) break;
         /* the length field says where the next request begins, whatever the
         ** function code: an unknown one is answered (exception 01) in step */
+        pthread_mutex_lock(&s->m->serve);
         size_t pl = mb_process(s->m, f + MBAP, len - 1, c->out + MBAP);
+        pthread_mutex_unlock(&s->m->serve);
         memcpy(c->out, f, 4);                         /* transaction, protocol */
         c->out[4] = (uint8_t)((pl + 1) >> 8);
         c->out[5] = (uint8_t)(pl + 1);
@@ -179,7 +181,10 @@ static void *server_thread(void *arg)
         uint64_t now = scan_now_ns();
         uint64_t next = expire(s, now);
         uint64_t wait = next - now;
-        if (mb_flush(s->m) && wait > WRITES_NS) wait = WRITES_NS;   /* hand writes over soon */
+        pthread_mutex_lock(&s->m->serve);
+        int pending = mb_flush(s->m);
+        pthread_mutex_unlock(&s->m->serve);
+        if (pending && wait > WRITES_NS) wait = WRITES_NS;        /* hand writes over soon */
         struct timespec to = { (time_t)(wait / 1000000000u), (long)(wait % 1000000000u) };
         int listening = now >= s->listen_pause;
         s->pf[0] = (struct pollfd){ s->wake, POLLIN, 0 };

@@ -5,9 +5,9 @@
 PLCRT_B    := $(BUILD)/plc_runtime
 PLCRT_CFLAGS := $(CFLAGS) -I plc_runtime $(shell pkg-config --cflags libmodbus 2>/dev/null || echo -I/usr/include/modbus)
 PLCRT_LIBS := -linih -lmodbus -lpthread -lm
-PLCRT_CORE := plc_image log stats config program mbmap mbserver retain scan \
+PLCRT_CORE := plc_image log stats config program mbmap mbserver mbrtu retain scan \
               trace force tracemb \
-              io_none io_sim io_backends
+              io_none io_sim io_backends io_multi io_modbus
 PLCRT_OBJ  := $(PLCRT_CORE:%=$(PLCRT_B)/%.o) $(C_BLOCKS_OBJ)
 include $(wildcard plc_runtime/canopen/part.mk)
 PLCRT_OBJ  += $(CO_BACKEND)
@@ -43,6 +43,7 @@ endef
 
 -include tests/runtime/tests.mk
 -include tests/canopen/tests.mk
+-include tests/remoteio/tests.mk
 
 # plcrt-parts: what plcrt-build (a user's project outside the tree) needs
 # from here, built, and listed in $(BUILD)/plc_runtime/parts.sh for it.

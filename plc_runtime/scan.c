@@ -30,7 +30,7 @@ void scan_diag(scan *s, uint16_t *d)
 {
     plc_stats *st = &s->stats;
     uint64_t n;
-    memset(d, 0, MB_DIAG_N * sizeof *d);
+    memset(d, 0, MB_DIAG_ALL * sizeof *d);
     put32(d, MBD_CYCLES, LD(st->cycles));
     put32(d, MBD_OVERRUNS, LD(st->overruns));
     put32(d, MBD_MISSED, LD(st->missed));
@@ -55,13 +55,20 @@ void scan_diag(scan *s, uint16_t *d)
         put32(d, MBD_EVICTED, LD(s->mb->evicted));
         put32(d, MBD_DROPPED, LD(s->mb->dropped));
         put32(d, MBD_EXCHANGE_MAX, LD(s->mb->exchange_max_ns) / 1000);
+        put32(d, MBD_RTU_SERVED, LD(s->mb->rtu_served));
+        put32(d, MBD_RTU_BAD, LD(s->mb->rtu_bad));
     }
     put32(d, MBD_RETAIN_SAVES, LD(s->retain_saves));
     put32(d, MBD_RETAIN_ERRORS, LD(s->retain_errors));
     put32(d, MBD_IO_ERRORS, LD(st->io_errors));
     if (s->force) put32(d, MBD_FORCED, (uint64_t)force_count(s->force));
     put32(d, MBD_UPTIME_S, (scan_now_ns() - s->started_ns) / 1000000000u);
-    if (s->io->diag) s->io->diag(s->io_state, d + MBD_BACKEND, MB_DIAG_N - MBD_BACKEND);
+    if (s->io->diag) {
+        /* every backend's block from input register 20000; the first
+        ** backend's first 64 registers also where they always were */
+        s->io->diag(s->io_state, d + MB_DIAG_N, MB_IODIAG_N);
+        memcpy(d + MBD_BACKEND, d + MB_DIAG_N, (MB_DIAG_N - MBD_BACKEND) * sizeof *d);
+    }
 }
 
 static void take_samples(scan *s)
@@ -103,7 +110,7 @@ int scan_sample_now(scan *s, const scan_sample *v, size_t n, int running, int ti
 __attribute__((noinline)) void scan_cycle(scan *s, uint64_t plc_ns, unsigned long tick)
 {
     const plc_program *p = s->prog;
-    uint16_t diag[MB_DIAG_N];
+    uint16_t diag[MB_DIAG_ALL];
     if (s->io->read_inputs(s->io_state, &plc_img, plc_ns))
         atomic_fetch_add_explicit(&s->stats.io_errors, 1, memory_order_relaxed);
     uint64_t x0 = s->mb ? scan_now_ns() : 0, x1 = 0;

@@ -426,14 +426,14 @@ static void loc_text(const plc_loc *l, char *out, size_t n)
 ** section copied and not edited) would leave the program the second one's
 ** values only, without a word. (Outputs may repeat: one %Q driving two
 ** objects.) 0, or -1 naming both. */
-static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
+static int list_inputs(void *vs, plc_image *img, io_input_use *in, int max)
 {
-    io_input_use in[MAX_BINDS + 2 * MAX_NODES];
+    st *s = vs;
     int k = 0;
     char t[32];
     for (int i = 0; i < s->nbinds; i++) {
         const bind *b = &s->binds[i];
-        if (b->loc.area != 'I')
+        if (b->loc.area != 'I' || k >= max)
             continue;
         loc_text(&b->loc, t, sizeof t);
         in[k].p = plc_loc_ptr(img, &b->loc);
@@ -448,14 +448,20 @@ static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
     for (int i = 0; i < s->nnodes; i++)
         for (int j = 0; j < 2; j++) {
             const plc_loc *l = j ? &s->ex[i].ok : &s->ex[i].status;
-            if (!(j ? s->ex[i].has_ok : s->ex[i].has_status))
+            if (!(j ? s->ex[i].has_ok : s->ex[i].has_status) || k >= max)
                 continue;
             loc_text(l, t, sizeof t);
             in[k].p = plc_loc_ptr(img, l);
             in[k].w = plc_loc_width(l);
             snprintf(in[k++].who, sizeof in[0].who, "[%.40s] %s %s", s->ex[i].name, j ? "ok" : "status", t);
         }
-    return io_inputs_apart(in, k, err, n);
+    return k;
+}
+
+static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
+{
+    io_input_use in[MAX_BINDS + 2 * MAX_NODES];
+    return io_inputs_apart(in, list_inputs(s, img, in, (int)(sizeof in / sizeof in[0])), err, n);
 }
 
 static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
@@ -640,5 +646,5 @@ static size_t diag(void *vs, uint16_t *r, size_t max)
 }
 
 const io_backend_ops io_canopen = {
-    "canopen", create, config, open_, rd, wr, safe, close_, diag
+    "canopen", create, config, open_, rd, wr, safe, close_, diag, list_inputs
 };

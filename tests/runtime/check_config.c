@@ -238,6 +238,106 @@ START_TEST(sim_master_follow)
 }
 END_TEST
 
+/* Several backends at once (docs/config.md [io]): each reads its own
+** sections; a bad list is refused naming the culprit. */
+START_TEST(several_backends)
+{
+    const char *t = "[io]\nbackend = none ,sim\n[sim.axis0]\ndac = %QW4\ncounter = %ID7\n";
+    ck_assert_msg(load(t) == 0, "%s", err);
+    ck_assert_str_eq(c.backend, "none, sim");
+    ck_assert_int_eq(io_multi_count(c.io_state), 2);
+    ck_assert_ptr_nonnull(io_multi_state(c.io_state, io_backend_find("sim")));
+    ck_assert_ptr_null(io_multi_state(c.io_state, io_backend_find("canopen")));
+    config_free(&c);
+    /* a section of the listed sim read by sim: its bad key refused */
+    ck_assert_int_ne(load("[io]\nbackend = none, sim\n[sim.axis0]\nnokey = 1\n"), 0);
+    ck_assert_msg(strstr(err, "[sim.axis0] nokey"), "%s", err);
+    config_free(&c);
+    static const struct { const char *v, *says; } bad[] = {
+        { "sim, sim", "backend sim listed twice" },
+        { "sim,", "may not end with a comma" },
+        { "sim,,none", "an empty name" },
+        { "sim, foo", "unknown backend 'foo'" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char txt[100];
+        snprintf(txt, sizeof txt, "[io]\nbackend = %s\n", bad[i].v);
+        ck_assert_int_ne(load(txt), 0);
+        ck_assert_msg(strstr(err, bad[i].says) && strstr(err, "[io] backend"), "%s: %s", bad[i].v, err);
+        config_free(&c);
+    }
+}
+END_TEST
+
+/* [modbus_io.NAME] (docs/remote-io.md): good keys taken, each bad one
+** refused naming file, line, section and key, and saying what is wanted */
+START_TEST(modbus_io_keys)
+{
+    const char *good = "[io]\nbackend = modbus_io\n[modbus_io.rack]\nhost = 10.0.0.2\nport = 1502\nunit = 3\n"
+                       "period_ms = 10\nword_order = low_first\nok = %IX10.0\n"
+                       "read = input 0 4 %IW0 safe=-5\nread = holding 10 2 %ID0\nread = discrete 0 16 %IX0.0\n"
+                       "write = coil 0 8 %QX0.0\nwrite = holding 100 2 %QD1\n"
+                       "[modbus_io.rtu]\ndevice = /dev/ttyUSB0\nbaud = 9600\nparity = odd\nstop_bits = 2\nslave = 7\n"
+                       "read = input 0 1 %IW10\n";
+    ck_assert_msg(load(good) == 0, "%s", err);
+    config_free(&c);
+    static const struct { const char *line, *says; } cases[] = {
+        { "read = input 0 126 %IW0", "count '126' is not in 1..125" },
+        { "read = input 0 4 %QW0", "a read block goes to an input" },
+        { "read = coil 0 4 %IW0", "coils are bits: give a %IX location" },
+        { "read = holding 0 3 %ID0", "give an even count" },
+        { "read = holding 0 4 %IX0.0", "registers go to %IW (16-bit) or %ID" },
+        { "write = input 0 4 %QW0", "cannot be written" },
+        { "write = coil 0 4 %IX0.0", "a write block goes to an output" },
+        { "read = input 0 4 %IW0 safe=70000", "a decimal value in -32768..65535" },
+        { "read = input 0 4 %IW0 hold", "the only option is safe=VALUE" },
+        { "read = register 0 4 %IW0", "table 'register' is not coil, discrete, input or holding" },
+        { "read = input 65535 2 %IW0", "pass address 65535" },
+        { "read = input 0 4 %IW1022", "pass the end of the image" },
+        { "read = input 0", "expected TABLE START COUNT LOCATION" },
+        { "parity = mark", "'mark' is not none, even or odd" },
+        { "word_order = big", "not high_first or low_first" },
+        { "ok = %QX0.0", "is not an input bit" },
+        { "slave = 0", "not a decimal number in 1..247" },
+        { "colour = red", "unknown key" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char txt[200];
+        snprintf(txt, sizeof txt, "[io]\nbackend = modbus_io\n[modbus_io.rack]\n%s\n", cases[i].line);
+        ck_assert_int_ne(load(txt), 0);
+        ck_assert_msg(strstr(err, cases[i].says) && strstr(err, "plant.ini:4: [modbus_io.rack]"), "%s: %s",
+                      cases[i].line, err);
+        config_free(&c);
+    }
+    /* a section without a name */
+    ck_assert_int_ne(load("[io]\nbackend = modbus_io\n[modbus_io]\nhost = x\n"), 0);
+    ck_assert_msg(strstr(err, "[modbus_io.NAME]"), "%s", err);
+    config_free(&c);
+}
+END_TEST
+
+/* [modbus_rtu] (docs/config.md): the map on a serial line */
+START_TEST(modbus_rtu_keys)
+{
+    ck_assert_msg(load("[modbus_rtu]\ndevice = /dev/ttyS1\nbaud = 9600\nparity = none\nstop_bits = 2\nslave = 9\n") == 0,
+                  "%s", err);
+    ck_assert_str_eq(c.rtu_device, "/dev/ttyS1");
+    ck_assert_int_eq(c.rtu_baud, 9600);
+    ck_assert_int_eq(c.rtu_parity, 'N');
+    ck_assert_int_eq(c.rtu_stop_bits, 2);
+    ck_assert_int_eq(c.rtu_slave, 9);
+    config_free(&c);
+    ck_assert_int_eq(load(""), 0);
+    ck_assert_str_eq(c.rtu_device, "");                 /* off by default */
+    ck_assert_int_eq(c.rtu_parity, 'E');                /* Modbus's default */
+    config_free(&c);
+    bad("[modbus_rtu]\nparity = mark\n", "plant.ini:2: [modbus_rtu] parity: 'mark' is not none, even or odd");
+    bad("[modbus_rtu]\nslave = 0\n", "[modbus_rtu] slave");
+    bad("[modbus_rtu]\nbaud = 9600\nbaud = 19200\n", "given twice (first on line 2)");
+    bad("[modbus_rtu]\nspeed = 9600\n", "[modbus_rtu] speed: unknown key");
+}
+END_TEST
+
 START_TEST(syntax)
 {
     bad("[plc]\nlog_level = info\nthis line has no equals sign\n", "plant.ini:3: syntax error");
@@ -674,6 +774,9 @@ int main(void)
     tcase_add_test(t, sim_modes_run);
     tcase_add_test(t, sim_master_markers);
     tcase_add_test(t, sim_master_follow);
+    tcase_add_test(t, several_backends);
+    tcase_add_test(t, modbus_io_keys);
+    tcase_add_test(t, modbus_rtu_keys);
     tcase_add_test(t, syntax);
     tcase_add_test(t, unknown);
     tcase_add_test(t, values);

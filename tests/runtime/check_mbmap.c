@@ -147,7 +147,7 @@ END_TEST
 START_TEST(input_edges)
 {
     img_set16(img.iw, 0, 0x0102); img_set16(img.iw, 1023, -2);
-    uint16_t diag[MB_DIAG_N] = {0};
+    uint16_t diag[MB_DIAG_ALL] = {0};
     diag[0] = 0xABCD; diag[MB_DIAG_N - 1] = 0x4242;
     mb_publish(m, &img, diag);
     req(4, 0, 1); OK(4); ck_assert_uint_eq(reg(0), 0x0102);

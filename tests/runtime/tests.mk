@@ -3,8 +3,8 @@
 
 RT_T := $(BUILD)/tests/runtime
 RT_CHECK_LIBS := $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lm -lrt -lpthread)
-RT_SRC_MAP := $(addprefix plc_runtime/,mbmap.c config.c program.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
-RT_SRC_CFG := $(addprefix plc_runtime/,config.c plc_image.c log.c io_backends.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
+RT_SRC_MAP := $(addprefix plc_runtime/,mbmap.c config.c program.c plc_image.c log.c io_backends.c io_multi.c io_modbus.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
+RT_SRC_CFG := $(addprefix plc_runtime/,config.c plc_image.c log.c io_backends.c io_multi.c io_modbus.c io_none.c io_sim.c) c_blocks/plant.c $(CO_BACKEND)
 RT_SRC_RET := plc_runtime/retain.c plc_runtime/log.c
 RT_SRC_TRACE := plc_runtime/trace.c plc_runtime/force.c plc_runtime/plc_image.c
 RT_SRC_TRACEMB := $(RT_SRC_TRACE) $(addprefix plc_runtime/,tracemb.c mbmap.c scan.c stats.c log.c program.c)
