@@ -18,16 +18,18 @@ whatever the host's load.  The steps (docs/aposs.md, "Tuning"):
      mean, above --osc qc: more than the encoder's one-count chatter) bracketed around
      what the plant measured in steps 3-4 predicts, then bisected to 2 %;
      KPROP = 70 % of the onset
-  6  KDER: 200, then 1.5 times more per run while the oscillation (RMS of
-     the following error about its mean, move and standstill) falls; the
-     value before the first rise is kept
+  6  KDER: 200, then 1.5 times more per run until the oscillation (RMS of
+     the following error about its mean, move and standstill) rises, more
+     than 10 % above the lowest so far; the last value before is kept
   7  KINT: only if a static following error (above 1 qc) remains
   9  BANDWIDTH: from just above what the PID used, lowered by 30 % per run
      while the following error stays within 10 % of its best
  10  POSERR back; a last run of the standard move (--dist) shows the result
 
-Each step's run is the shortest move that shows what it measures: a
-plateau of 0.1 s (step 3), a move that just reaches VEL (steps 4-9).  The
+Each step's run is the shortest move that shows what it measures: one that
+just reaches VEL for the ramps (step 4) and the oscillation after a move
+(step 5), one with 0.1 s at VEL for the constant speed (step 3) and for the
+following error all along a move (steps 6-9).  The
 axis is switched off and on before each run (it starts at rest where it
 is) and moves alternately towards its start position, so it stays within
 the software limits.  Written to --out: aposs-tune-report.txt (every run,
@@ -302,7 +304,7 @@ class Tuner:
         d_ramp = math.ceil(self.v ** 2 / self.acc)              # reaches VEL, no constant speed
         d_plat = math.ceil(self.v ** 2 / self.acc + 0.1 * self.v)   # and 0.1 s of it
         log(f"test moves: VEL {a.vel} = {self.v:.0f} qc/s, ACC {a.acc} = {self.acc:.0f} qc/s2; "
-            f"{d_plat} qc (0.1 s at VEL) for FFVEL, {d_ramp} qc (just reaching VEL) for the others")
+            f"{d_ramp} qc (just reaching VEL) for FFACC and KPROP, {d_plat} qc (and 0.1 s at VEL) for the others")
         log(f"before: " + " ".join(f"{k} {orig[k]}" for k in GAINS))
         ax.set("POSERR", a.poserr)                                          # step 2
         log(f"step 2: POSERR {a.poserr} (was {orig['POSERR']})")
@@ -373,31 +375,33 @@ class Tuner:
         self.kprop = max(1, round(0.7 * hi))
         log(f"step 5: oscillation from KPROP {hi} (steady at {lo}): KPROP = 70 % = {self.kprop}")
 
-        c = self.run("6", d_ramp, 0.3, KPROP=self.kprop, KDER=0, KINT=0)     # step 6
+        c = self.run("6", d_plat, 0.3, KPROP=self.kprop, KDER=0, KINT=0)     # step 6
         best = (self.oscillation(c), 0, c)
         log(f"step 6 run {self.runs}: KDER 0: oscillation {best[0]:.3f} qc")
-        kd, worse = 200, 0
-        while kd <= 65000 and worse < 2:
-            c = self.run("6", d_ramp, 0.3, KDER=kd)
+        kd, last, lowest = 200, best, best[0]
+        while kd <= 65000:
+            c = self.run("6", d_plat, 0.3, KDER=kd)
             m = self.oscillation(c)
-            log(f"step 6 run {self.runs}: KDER {kd}: oscillation {m:.3f} qc")
-            # a rise of one run may be the encoder's rounding: the
-            # oscillations rise when two runs in a row are worse than the best
-            if m > best[0]:
-                worse += 1
-            else:
-                best, worse = (m, kd, c), 0
+            # a change within 10 % is the encoder's rounding, not the gain's:
+            # the oscillations rise when they exceed the lowest so far by more
+            rise = m > 1.1 * lowest
+            log(f"step 6 run {self.runs}: KDER {kd}: oscillation {m:.3f} qc"
+                + (f" (more than 10 % above the lowest, {lowest:.3f}: they rise)" if rise else ""))
+            if rise:
+                break
+            last, lowest = (m, kd, c), min(lowest, m)
             kd = round(kd * 1.5)
+        best = last
         self.kder = best[1]
         self.steps["6"] = best[2]
         ax.set("KDER", self.kder)
-        log(f"step 6: KDER {self.kder} (the oscillations rose after it)")
+        log(f"step 6: KDER {self.kder}, the last value before the oscillations rose")
 
         _, _, static = self.standstill(best[2])                              # step 7
         self.kint = 0
         while abs(static) > 1.0 and self.kint < 64:
             self.kint = max(1, self.kint * 2)
-            c = self.run("7", d_ramp, 0.3, KINT=self.kint)
+            c = self.run("7", d_plat, 0.3, KINT=self.kint)
             _, _, static = self.standstill(c)
             log(f"step 7 run {self.runs}: KINT {self.kint}: static following error {static:+.2f} qc")
         if self.kint == 0:
@@ -413,11 +417,12 @@ class Tuner:
         good = bw
         while bw > 1:
             bw = max(1, math.floor(bw * 0.7))
-            c = self.run("9", d_ramp, 0.3, BANDWIDTH=bw)
+            c = self.run("9", d_plat, 0.3, BANDWIDTH=bw)
             m = self.oscillation(c)
             ok = m <= 1.1 * fe_best
+            fe_best = min(fe_best, m)
             log(f"step 9 run {self.runs}: BANDWIDTH {bw}: following error {m:.3f} qc "
-                f"({'within' if ok else 'beyond'} 10 % of {fe_best:.3f})")
+                f"({'within' if ok else 'beyond'} 10 % of the best, {fe_best:.3f})")
             if not ok:
                 break
             good = bw
