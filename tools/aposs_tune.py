@@ -20,10 +20,11 @@ whatever the host's load.  The steps (docs/aposs.md, "Tuning"):
      KPROP = 70 % of the onset
   6  KDER: 200, then 1.5 times more per run until the oscillation (RMS of
      the following error about its mean, move and standstill) rises, more
-     than 10 % above the lowest so far; the last value before is kept
+     than 15 % above the lowest so far; the last value before is kept
   7  KINT: only if a static following error (above 1 qc) remains
   9  BANDWIDTH: from just above what the PID used, lowered by 30 % per run
-     while the following error stays within 10 % of its best
+     while the following error (its RMS and its peak) stays within 10 % of
+     its best
  10  POSERR back; a last run of the standard move (--dist) shows the result
 
 Each step's run is the shortest move that shows what it measures: one that
@@ -200,8 +201,11 @@ class Tuner:
         cols["missed"] = sum(1 for i in range(1, len(ticks)) if ticks[i] - ticks[i - 1] > 1.5 * self.period)
         return cols
 
-    def run(self, step, dist, post_s=0.3, **gains):
-        """One test run of step with the given parameters (the others as they are)."""
+    def run(self, step, dist, post_s=0.3, back=False, **gains):
+        """One test run of step with the given parameters (the others as
+        they are); back: there and back, as the seed's Testrun, the return
+        move recorded as c["back"] (where within a count each move starts
+        differs: the measures take the mean of both)."""
         ax = self.ax
         for k, v in gains.items():
             ax.set(k, v)
@@ -212,8 +216,13 @@ class Tuner:
             raise SystemExit(f"aposs_tune: the axis has error {ax.out('ERRNUM')} (parameters: {gains})")
         self.sign = 1 if ax.out("APOS") <= self.p0 else -1
         c = self.capture(dist, post_s)
-        self.runs += 1
         self.plc_s += c["T"][-1] - c["T"][0]
+        if back:
+            self.sign = -self.sign
+            c["back"] = self.capture(dist, post_s)
+            self.plc_s += c["back"]["T"][-1] - c["back"]["T"][0]
+            c["missed"] += c["back"]["missed"]
+        self.runs += 1
         if ax.flag("ERROR"):
             raise SystemExit(f"aposs_tune: error {ax.out('ERRNUM')} in run {self.runs} ({step}, {gains})")
         with open(os.path.join(self.a.out, f"aposs-tune-run{self.runs}.csv"), "w") as f:
@@ -285,13 +294,16 @@ class Tuner:
 
     def oscillation(self, c):
         """RMS of the following error about its mean, from the move's start
-        to 0.2 s after its end"""
-        a0, _, _, d1, _ = self.phases(c)
-        return self.swing(c, a0, min(len(c["FE"]), d1 + int(0.2 / self.period)))
+        to 0.2 s after its end (the mean of there and back)"""
+        def one(c):
+            a0, _, _, d1, _ = self.phases(c)
+            return self.swing(c, a0, min(len(c["FE"]), d1 + int(0.2 / self.period)))
+        return sum(one(x) for x in both(c)) / len(both(c))
 
     @staticmethod
     def fe_peak(c):
-        return max(abs(x) for x in c["FE"])
+        """peak |following error| (the mean of there and back)"""
+        return sum(max(abs(x) for x in y["FE"]) for y in both(c)) / len(both(c))
 
     # ---- the steps ----
     def tune(self):
@@ -321,6 +333,7 @@ class Tuner:
             if done:
                 break
         self.ffvel = ffvel
+        ax.set("FFVEL", ffvel)
         self.drive = va / (ffvel / 1000 * 32767 * vc / (ax.get("VELMAX") * ax.get("ENCODER") * 4 / 60.0))
 
         pts = []                                                            # step 4
@@ -350,8 +363,9 @@ class Tuner:
         log(f"the plant: {self.drive:.4f} qc/s per DAC bit, a lag of {1000 * self.tau:.2f} ms")
 
         def oscillates(kp):                                                 # step 5
-            c = self.run("5", d_ramp, 0.4, KPROP=kp, KDER=0, KINT=0)
-            s0, s1, _ = self.standstill(c)
+            c = self.run("5", d_ramp, 0.4, True, KPROP=kp, KDER=0, KINT=0)
+            sw = [self.standstill(x)[:2] for x in both(c)]
+            s0, s1 = (sum(x[0] for x in sw) / 2, sum(x[1] for x in sw) / 2)
             osc = s1 > a.osc
             log(f"step 5 run {self.runs}: KPROP {kp}: following error swing at standstill {s0:.2f} qc, "
                 f"0.3 s later {s1:.2f} qc: {'oscillating' if osc else 'steady'}")
@@ -375,18 +389,19 @@ class Tuner:
         self.kprop = max(1, round(0.7 * hi))
         log(f"step 5: oscillation from KPROP {hi} (steady at {lo}): KPROP = 70 % = {self.kprop}")
 
-        c = self.run("6", d_plat, 0.3, KPROP=self.kprop, KDER=0, KINT=0)     # step 6
+        c = self.run("6", d_plat, 0.3, True, KPROP=self.kprop, KDER=0, KINT=0)     # step 6
         best = (self.oscillation(c), 0, c)
         log(f"step 6 run {self.runs}: KDER 0: oscillation {best[0]:.3f} qc")
         kd, last, lowest = 200, best, best[0]
         while kd <= 65000:
-            c = self.run("6", d_plat, 0.3, KDER=kd)
+            c = self.run("6", d_plat, 0.3, True, KDER=kd)
             m = self.oscillation(c)
-            # a change within 10 % is the encoder's rounding, not the gain's:
-            # the oscillations rise when they exceed the lowest so far by more
-            rise = m > 1.1 * lowest
+            # a change within 15 % is the encoder's rounding (where within a
+            # count the run started), not the gain's: the oscillations rise
+            # when they exceed the lowest so far by more
+            rise = m > 1.15 * lowest
             log(f"step 6 run {self.runs}: KDER {kd}: oscillation {m:.3f} qc"
-                + (f" (more than 10 % above the lowest, {lowest:.3f}: they rise)" if rise else ""))
+                + (f" (more than 15 % above the lowest, {lowest:.3f}: they rise)" if rise else ""))
             if rise:
                 break
             last, lowest = (m, kd, c), min(lowest, m)
@@ -401,28 +416,29 @@ class Tuner:
         self.kint = 0
         while abs(static) > 1.0 and self.kint < 64:
             self.kint = max(1, self.kint * 2)
-            c = self.run("7", d_plat, 0.3, KINT=self.kint)
+            c = self.run("7", d_plat, 0.3, True, KINT=self.kint)
             _, _, static = self.standstill(c)
             log(f"step 7 run {self.runs}: KINT {self.kint}: static following error {static:+.2f} qc")
         if self.kint == 0:
             log(f"step 7: static following error {static:+.2f} qc, within a count: no KINT (step 8 has no KILIM to lower)")
         ax.set("KINT", self.kint)
 
-        ref = self.steps.get("7", best[2])                                   # step 9
-        fe_best = self.oscillation(ref)
+        ref = self.steps.get("7", best[2])
+        fe_best, pk_best = self.oscillation(ref), self.fe_peak(ref)
         peak = max(abs(x) for x in ref["PIDPART"])
         bw = max(1, min(1000, math.ceil(1.25 * 1000 * peak / 32767)))
         log(f"step 9: the PID used at most {peak:.0f} DAC bits ({1000 * peak / 32767:.1f} / 1000): "
-            f"BANDWIDTH {bw} clamps nothing; following error {fe_best:.3f} qc")
+            f"BANDWIDTH {bw} clamps nothing; following error {fe_best:.3f} qc RMS, {pk_best:.3f} qc peak")
         good = bw
         while bw > 1:
             bw = max(1, math.floor(bw * 0.7))
-            c = self.run("9", d_plat, 0.3, BANDWIDTH=bw)
-            m = self.oscillation(c)
-            ok = m <= 1.1 * fe_best
-            fe_best = min(fe_best, m)
-            log(f"step 9 run {self.runs}: BANDWIDTH {bw}: following error {m:.3f} qc "
-                f"({'within' if ok else 'beyond'} 10 % of the best, {fe_best:.3f})")
+            c = self.run("9", d_plat, 0.3, True, BANDWIDTH=bw)
+            m, pk = self.oscillation(c), self.fe_peak(c)
+            # the following error, its RMS and its peak, within 10 % of the best
+            ok = m <= 1.1 * fe_best and pk <= 1.1 * pk_best
+            log(f"step 9 run {self.runs}: BANDWIDTH {bw}: following error {m:.3f} qc RMS, {pk:.3f} qc peak "
+                f"({'within' if ok else 'beyond'} 10 % of the best, {fe_best:.3f} and {pk_best:.3f})")
+            fe_best, pk_best = min(fe_best, m), min(pk_best, pk)
             if not ok:
                 break
             good = bw
@@ -464,6 +480,11 @@ class Tuner:
         fig.tight_layout()
         fig.savefig(path, dpi=80)
         plt.close(fig)
+
+
+def both(c):
+    """a run's captures: there, and back if it went back"""
+    return [c, c["back"]] if "back" in c else [c]
 
 
 def predicted_onset(kd, tau, T):
