@@ -4,7 +4,9 @@
 ** such section one axis runs with the default bindings (docs/config.md).
 ** [sim.master] adds a master axis that runs by itself (or an encoder on
 ** one of the axes), [sim.marker0..3] marker sensors on the master or an
-** axis: the plants of the CAM examples.
+** axis: the plants of the CAM examples. [sim] clock = cycles runs the
+** plants in the program's time (one task interval per scan executed), so
+** that a loaded host, whose late scans skip cycles, sees the same motion.
 */
 #include <math.h>
 #include <stddef.h>
@@ -66,6 +68,8 @@ typedef struct sim {
     int configured;       /* any [sim.axisN] seen */
     uint64_t last_ns;
     int started;
+    int cycles;           /* [sim] clock = cycles: one tick per scan executed */
+    uint64_t tick_ns;
 } sim;
 
 static void axis_defaults(sim_axis *a)
@@ -181,7 +185,16 @@ static int config(void *st, const char *sec, const char *key, const char *v, cha
         if (idx >= SIM_MARKERS) { snprintf(err, n, "unknown section (markers are [sim.marker0] .. [sim.marker3])"); return -1; }
         return config_marker(&s->mk[idx], key, v, err, n);
     }
-    if (!strcmp(sec, "sim")) { snprintf(err, n, "unknown key (axes are [sim.axis0] .. [sim.axis7])"); return -1; }
+    if (!strcmp(sec, "sim")) {
+        if (!strcmp(key, "clock")) {
+            if (!strcmp(v, "plc") || !strcmp(v, "cycles")) { s->cycles = !strcmp(v, "cycles"); return 0; }
+            snprintf(err, n, "'%s': plc (the plant moves on by the PLC time, missed cycles too) "
+                     "or cycles (one task interval per scan executed)", v);
+            return -1;
+        }
+        snprintf(err, n, "unknown key (clock; axes are [sim.axis0] .. [sim.axis7])");
+        return -1;
+    }
     if (sscanf(sec, "sim.axis%u%c", &idx, &tail) != 1 || idx >= SIM_AXES) {
         snprintf(err, n, "unknown section (axes are [sim.axis0] .. [sim.axis7])");
         return -1;
@@ -278,7 +291,7 @@ static int inputs_apart(sim *s, plc_image *img, char *err, size_t n)
 static int open_(void *st, plc_image *img, uint64_t tick, char *err, size_t n)
 {
     sim *s = st;
-    (void)tick;
+    s->tick_ns = tick;
     for (int i = 0; i < SIM_AXES; i++) {
         sim_axis *a = &s->ax[i];
         if (!a->used) continue;
@@ -333,7 +346,9 @@ static int32_t acc_dint(double a)
 static int rd(void *st, plc_image *img, uint64_t now)
 {
     sim *s = st;
-    double dt = s->started ? (now - s->last_ns) * 1e-9 : 0;
+    /* clock = cycles: a scan that came too late skipped cycles of PLC time,
+    ** the plant skips none (it runs in lockstep with the program) */
+    double dt = !s->started ? 0 : s->cycles ? s->tick_ns * 1e-9 : (now - s->last_ns) * 1e-9;
     s->started = 1;
     s->last_ns = now;
     for (int i = 0; i < SIM_AXES; i++) {

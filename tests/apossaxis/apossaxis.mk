@@ -12,8 +12,9 @@ test-apossaxis: $(ST_LIB) $(STC)
 	    CFLAGS="$(CFLAGS)" tests/apossaxis/run.sh $(BUILD)/tests/apossaxis $(ST_LIB) $(APOSSAXIS_TESTS)
 
 # test-apossaxis-tune: the seed 001 tuning procedure (tools/aposs_tune.py) on
-# the APOSS example under plcrt, over Modbus and the trace (1.5 to 3 min:
-# some 50 test moves in real time, more where scans come late)
+# the APOSS example under plcrt, over Modbus and the trace, then the test's
+# own onset bisection and standard moves (about 1.5 min: some 45 moves in
+# real time)
 TESTS += test-apossaxis-tune
 STRESS_TESTS += test-apossaxis-tune
 .PHONY: test-apossaxis-tune

@@ -5,13 +5,15 @@
 #                       (ruckig_peer.py driving drive.c + drive.st)
 #   test-ljprof-extremes  limits over twelve decades, starts beyond them:
 #                       accepted, finite, exactly on target (extremes.py)
+#   test-ljprof-fourjerk  a reversal with four different jerks against its
+#                       optimum worked out phase by phase (fourjerk.py)
 LJPROF_TESTS := $(wildcard tests/ljprof/t_*.st)
 LJPROF_B     := $(BUILD)/tests/ljprof
 
-TESTS += test-ljprof test-ljprof-ruckig test-ljprof-extremes
+TESTS += test-ljprof test-ljprof-ruckig test-ljprof-extremes test-ljprof-fourjerk
 MATIEC_TESTS += test-ljprof
 
-.PHONY: test-ljprof test-ljprof-ruckig test-ljprof-extremes
+.PHONY: test-ljprof test-ljprof-ruckig test-ljprof-extremes test-ljprof-fourjerk
 test-ljprof: $(ST_LIB) $(STC)
 	@mk/suite.sh $(RESULTS) ljprof env STC="$(STC)" STC_INC="$(STC_INC)" CC="$(CC)" \
 	    CFLAGS="$(CFLAGS) $(SAN)" tests/ljprof/run.sh $(LJPROF_B) $(ST_LIB) $(LJPROF_TESTS)
@@ -28,3 +30,6 @@ test-ljprof-ruckig: $(LJPROF_B)/drive/drive
 
 test-ljprof-extremes: $(LJPROF_B)/drive/drive
 	@mk/suite.sh $(RESULTS) ljprof-extremes python3 tests/ljprof/extremes.py $< 4000
+
+test-ljprof-fourjerk: $(LJPROF_B)/drive/drive
+	@mk/suite.sh $(RESULTS) ljprof-fourjerk python3 tests/ljprof/fourjerk.py $<

@@ -213,6 +213,38 @@ START_TEST(sim_master_markers)
 }
 END_TEST
 
+/* [sim] clock: plc moves the plant on by the PLC time between two scans
+** (missed cycles too, as a real axis), cycles by one task interval per
+** scan: 5 V for 100 scans whose PLC time jumps by 3 ms once (a late scan)
+** gives 102 ms and 100 ms of motion at 5000 counts/s (lag 0). */
+START_TEST(sim_clock)
+{
+    const io_backend_ops *o = io_backend_find("sim");
+    static plc_image img;
+    char e[300];
+    for (int cyc = 0; cyc <= 1; cyc++) {
+        void *st = o->create();
+        SET("sim.axis0", "dac", "%QW0"); SET("sim.axis0", "counter", "%ID0"); SET("sim.axis0", "lag", "0");
+        SET("sim.axis0", "maxvel", "10000");
+        if (cyc) SET("sim", "clock", "cycles");
+        ck_assert_msg(o->open(st, &img, 1000000, e, sizeof e) == 0, "%s", e);
+        img_set16(img.qw, 0, 16384);
+        uint64_t t = 0;
+        for (int i = 0; i <= 100; i++) {
+            t += i == 50 ? 3000000 : i ? 1000000 : 0;
+            ck_assert_int_eq(o->read_inputs(st, &img, t), 0);
+            o->write_outputs(st, &img);
+        }
+        double x = 10000 * (16384 * 10.0 / 32767) / 10 * (cyc ? 0.100 : 0.102);
+        ck_assert_msg(fabs(img_get32(img.id, 0) - x) <= 2, "clock %s: %d counts, expected about %.0f",
+                      cyc ? "cycles" : "plc", img_get32(img.id, 0), x);
+        o->close(st);
+    }
+    bad("[sim]\nclock = wall\n", "'wall': plc (the plant moves on by the PLC time");
+    bad("[sim]\nclk = plc\n", "unknown key (clock;");
+}
+END_TEST
+
 /* follow: an encoder on an axis: start + ratio x the axis's position */
 START_TEST(sim_master_follow)
 {
@@ -777,6 +809,7 @@ int main(void)
     tcase_add_test(t, several_backends);
     tcase_add_test(t, modbus_io_keys);
     tcase_add_test(t, modbus_rtu_keys);
+    tcase_add_test(t, sim_clock);
     tcase_add_test(t, syntax);
     tcase_add_test(t, unknown);
     tcase_add_test(t, values);
