@@ -33,3 +33,4 @@ test-remoteio-example: $(BUILD)/plc/remoteio/plcrt
 	  $(abspath $(RIO_T))/example
 TESTS += test-remoteio-example
 MATIEC_TESTS += test-remoteio test-rtuserver test-remoteio-example
+STRESS_TESTS += test-remoteio test-rtuserver test-remoteio-example
