@@ -214,7 +214,7 @@ int main(void)
     tcase_add_test(tc, forcing_moments);
     suite_add_tcase(s, tc);
     SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
+    srunner_run_all(r, CK_ENV);
     int n = srunner_ntests_failed(r);
     srunner_free(r);
     return n ? 1 : 0;

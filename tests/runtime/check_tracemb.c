@@ -187,7 +187,7 @@ int main(void)
     tcase_add_test(tc, force_values);
     suite_add_tcase(s, tc);
     SRunner *r = srunner_create(s);
-    srunner_run_all(r, CK_NORMAL);
+    srunner_run_all(r, CK_ENV);
     int n = srunner_ntests_failed(r);
     srunner_free(r);
     return n ? 1 : 0;
