@@ -156,6 +156,7 @@ class Link:
         self.table()
         d["programs"] = sorted({".".join(v["path"].split(".")[:3]) for v in self.vars if v["path"].count(".") >= 2})
         d["watch_state"] = self.watch_state
+        d["watching"] = len(self.wanted)
         self.diag_cache, self.diag_time = d, now
         return d
 
@@ -355,6 +356,19 @@ class Link:
                             f[k] = None
                     found.append({"kind": kind, "path": head, "fields": f})
                     break
+        # A program that copies its own command variable into the block's
+        # input every cycle (the examples' cSTOP -> Axis.STOP) overwrites a
+        # forced input before the block runs: there the command goes through
+        # that variable, <program>.C<COMMAND>, when the program has one axis.
+        parents = [a["path"].rpartition(".")[0] for a in found]
+        for a in found:
+            parent = a["path"].rpartition(".")[0]
+            for act in ("stop", "reset"):
+                cmd = a["fields"].get(act)
+                if cmd and parents.count(parent) == 1:
+                    alt = f"{parent}.C{cmd.rpartition('.')[2]}"
+                    if alt.upper() in self.by_path:
+                        a["fields"][act] = self.by_path[alt.upper()]["path"]
         return sorted(found, key=lambda a: a["path"])
 
     def axis_action(self, path, action):

@@ -43,3 +43,5 @@ include tests/xmlexport/xmlexport.mk
 include tests/cam/cam.mk
 # ---- docs/getting-started.md, run as the page says ----
 include tests/getting_started/getting_started.mk
+# ---- plcweb: the web page in a headless browser, its security ----
+include tests/web/web.mk

@@ -1,0 +1,17 @@
+# plcweb (plcweb/) in a real headless browser against the EPICPOS example's
+# plcrt: each page, a watched move, forcing, a trace against plctrace's CSV,
+# a project upload with an error and a good one switched in; and its
+# security over plain HTTP. `make web-screenshots` writes the pages'
+# screenshots of docs/web.md into docs/img.
+WEB_T := $(BUILD)/tests/web
+.PHONY: test-web web-screenshots
+test-web: $(BUILD)/plc/epicpos/plcrt plcrt-parts
+	@rm -rf $(WEB_T) && mkdir -p $(WEB_T)
+	@mk/suite.sh $(RESULTS) web python3 tests/web/test_web.py \
+	    $(BUILD)/plc/epicpos/plcrt examples/epicpos/epicpos.ini $(abspath $(WEB_T))
+TESTS += test-web
+
+web-screenshots: $(BUILD)/plc/epicpos/plcrt plcrt-parts
+	@rm -rf $(WEB_T) && mkdir -p $(WEB_T)
+	@python3 tests/web/test_web.py $(BUILD)/plc/epicpos/plcrt examples/epicpos/epicpos.ini \
+	    $(abspath $(WEB_T)) $(abspath docs/img)
