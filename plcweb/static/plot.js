@@ -4,6 +4,7 @@
 // (their values and the difference shown below the plot). series holds
 // exactly the points drawn: {path, t: [...], v: [...]} per channel.
 "use strict";
+function num(v) { return v === null || Number.isInteger(v) ? String(v) : Number(v.toPrecision(7)).toString(); }
 const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"];
 class Plot {
   constructor(canvas, readout) {
@@ -24,6 +25,7 @@ class Plot {
       this.draw();
     });
     canvas.addEventListener("dblclick", () => this.zoomOut());
+    this.draw();
   }
   set(d) {
     this.series = d.cols.map(c => ({path: c.path, t: d.time_ms.slice(), v: c.values.slice()}));
@@ -43,7 +45,7 @@ class Plot {
     const t = this.series[0].t;
     return this.view || [t[0], t[t.length - 1] === t[0] ? t[0] + 1 : t[t.length - 1]];
   }
-  box() { return {l: 70, r: this.canvas.width - 10, t: 10, b: this.canvas.height - 60}; }
+  box() { return {l: 70, r: this.canvas.width - 10, t: 10, b: this.canvas.height - 36}; }
   tOf(x) { const b = this.box(), [a, c] = this.range(); return a + (x - b.l) / (b.r - b.l) * (c - a); }
   xOf(t) { const b = this.box(), [a, c] = this.range(); return b.l + (t - a) / (c - a) * (b.r - b.l); }
   valueAt(s, t) {      // the step's value at time t (the last sample at or before it)
@@ -57,26 +59,25 @@ class Plot {
     g.fillStyle = "#fff"; g.fillRect(0, 0, W, H);
     if (!this.series.length) { g.fillStyle = "#888"; g.fillText("no capture yet", W / 2 - 30, H / 2); return; }
     const [t0, t1] = this.range(), shown = this.shown();
-    let lo = Infinity, hi = -Infinity;
-    for (const s of shown) for (let i = 0; i < s.t.length; i++)
-      if (s.t[i] >= t0 && s.t[i] <= t1) { lo = Math.min(lo, s.v[i]); hi = Math.max(hi, s.v[i]); }
-    if (!isFinite(lo)) { lo = 0; hi = 1; }
-    if (hi === lo) { hi += 1; lo -= 1; }
-    const pad = (hi - lo) * 0.05; lo -= pad; hi += pad;
-    const yOf = v => b.b - (v - lo) / (hi - lo) * (b.b - b.t);
-    g.strokeStyle = "#ddd"; g.fillStyle = "#444"; g.font = "11px sans-serif"; g.lineWidth = 1;
-    for (let k = 0; k <= 5; k++) {
-      const v = lo + (hi - lo) * k / 5, y = yOf(v);
-      g.beginPath(); g.moveTo(b.l, y); g.lineTo(b.r, y); g.stroke();
-      g.fillText(Number(v.toPrecision(5)).toString(), 2, y + 4);
-      const t = t0 + (t1 - t0) * k / 5, x = this.xOf(t);
-      g.beginPath(); g.moveTo(x, b.t); g.lineTo(x, b.b); g.stroke();
-      g.fillText(Number(t.toPrecision(5)).toString(), x - 12, b.b + 14);
-    }
-    g.fillText("PLC time from the trigger (ms)", (b.l + b.r) / 2 - 70, b.b + 28);
-    if (t0 <= 0 && 0 <= t1) { g.strokeStyle = "#888"; g.setLineDash([2, 3]); g.beginPath(); g.moveTo(this.xOf(0), b.t); g.lineTo(this.xOf(0), b.b); g.stroke(); g.setLineDash([]); }
-    g.save(); g.beginPath(); g.rect(b.l, b.t, b.r - b.l, b.b - b.t); g.clip();
-    shown.forEach((s, k) => {
+    const rows = shown.length, rh = (b.b - b.t) / rows;
+    g.font = "11px sans-serif"; g.lineWidth = 1;
+    shown.forEach((s, k) => {     // one row per channel, each with its own scale (as plctrace's PNG)
+      const top = b.t + k * rh, bot = top + rh - 6;
+      let lo = Infinity, hi = -Infinity;
+      for (let i = 0; i < s.t.length; i++)
+        if (s.t[i] >= t0 && s.t[i] <= t1) { lo = Math.min(lo, s.v[i]); hi = Math.max(hi, s.v[i]); }
+      if (!isFinite(lo)) { lo = 0; hi = 1; }
+      if (hi === lo) { hi += 1; lo -= 1; }
+      const pad = (hi - lo) * 0.08; lo -= pad; hi += pad;
+      const yOf = v => bot - (v - lo) / (hi - lo) * (bot - top);
+      g.strokeStyle = "#ccc"; g.strokeRect(b.l, top, b.r - b.l, bot - top);
+      g.fillStyle = "#444";
+      for (let j = 0; j <= 2; j++) {
+        const v = lo + (hi - lo) * (0.1 + 0.4 * j), y = yOf(v);
+        g.strokeStyle = "#eee"; g.beginPath(); g.moveTo(b.l, y); g.lineTo(b.r, y); g.stroke();
+        g.fillText(Number(v.toPrecision(5)).toString(), 2, y + 4);
+      }
+      g.save(); g.beginPath(); g.rect(b.l, top, b.r - b.l, bot - top); g.clip();
       g.strokeStyle = COLORS[k % COLORS.length]; g.lineWidth = 1.2; g.beginPath();
       let first = true, prevY = 0;
       for (let i = 0; i < s.t.length; i++) {
@@ -86,24 +87,31 @@ class Plot {
         if (first) { g.moveTo(x, y); first = false; } else { g.lineTo(x, prevY); g.lineTo(x, y); }
         prevY = y;
       }
+      if (!first) g.lineTo(b.r, prevY);
       g.stroke();
-    });
-    g.restore();
-    shown.forEach((s, k) => {
+      g.restore();
       g.fillStyle = COLORS[k % COLORS.length];
-      g.fillText(s.path.split(".").slice(2).join(".") || s.path, b.l + 10 + 200 * (k % 4), b.b + 44 + 12 * Math.floor(k / 4));
+      g.fillText(s.path.split(".").slice(2).join(".") || s.path, b.l + 6, top + 12);
     });
+    g.fillStyle = "#444"; g.strokeStyle = "#ddd";
+    for (let k = 0; k <= 5; k++) {
+      const t = t0 + (t1 - t0) * k / 5, x = this.xOf(t);
+      g.beginPath(); g.moveTo(x, b.t); g.lineTo(x, b.b); g.stroke();
+      g.fillText(Number(t.toPrecision(5)).toString(), x - (k === 5 ? 30 : 12), b.b + 14);
+    }
+    g.fillText("PLC time from the trigger (ms)", (b.l + b.r) / 2 - 70, b.b + 28);
+    if (t0 <= 0 && 0 <= t1) { g.strokeStyle = "#888"; g.setLineDash([2, 3]); g.beginPath(); g.moveTo(this.xOf(0), b.t); g.lineTo(this.xOf(0), b.b); g.stroke(); g.setLineDash([]); }
     const names = ["A", "B"], texts = [];
     this.cursors.forEach((c, k) => {
       if (c === null) return;
       const x = this.xOf(c);
       g.strokeStyle = k ? "#a0a" : "#0a0"; g.beginPath(); g.moveTo(x, b.t); g.lineTo(x, b.b); g.stroke();
       g.fillStyle = g.strokeStyle; g.fillText(names[k], x + 3, b.t + 12);
-      texts.push(`${names[k]}: t = ${c.toFixed(3)} ms, ` + shown.map(s => `${s.path.split(".").pop()} = ${this.valueAt(s, c)}`).join(", "));
+      texts.push(`${names[k]}: t = ${c.toFixed(3)} ms, ` + shown.map(s => `${s.path.split(".").pop()} = ${num(this.valueAt(s, c))}`).join(", "));
     });
     if (this.cursors[0] !== null && this.cursors[1] !== null)
       texts.push(`B − A: ${(this.cursors[1] - this.cursors[0]).toFixed(3)} ms, ` +
-        shown.map(s => `${s.path.split(".").pop()} ${this.valueAt(s, this.cursors[1]) - this.valueAt(s, this.cursors[0])}`).join(", "));
+        shown.map(s => `${s.path.split(".").pop()} ${num(this.valueAt(s, this.cursors[1]) - this.valueAt(s, this.cursors[0]))}`).join(", "));
     this.readout.textContent = texts.join("  |  ");
     if (this.drag) { g.fillStyle = "rgba(0,0,200,0.1)"; g.fillRect(Math.min(this.drag.x0, this.drag.x1), b.t, Math.abs(this.drag.x1 - this.drag.x0), b.b - b.t); }
   }

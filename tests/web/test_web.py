@@ -457,6 +457,10 @@ def pages(drv, wport, mb, port, shots, work):
            view and view[0] < view[1] and view[1] - view[0] < series[0]["t"][-1] - series[0]["t"][0]
            and None not in cur and "B − A" in text(drv, "tr-cursor"), f"{view} {cur} {text(drv, 'tr-cursor')}")
     drv.find_element(By.ID, "tr-diff").click()
+    drv.find_element(By.ID, "tr-reset").click()
+    report("trace: Zoom out shows the whole capture again, the difference of channels 1 and 2 as a fourth row",
+           drv.execute_script("return plcwebPlot.view") is None
+           and drv.execute_script("return plcwebPlot.shown().length") == 4)
     drv.save_screenshot(os.path.join(shots, "web-trace.png"))
     drv.find_element(By.ID, "tr-png").click()
     href = drv.find_element(By.ID, "tr-png").get_attribute("href")
