@@ -16,6 +16,7 @@ import importlib.machinery
 import importlib.util
 import os
 import shutil
+import socket
 import struct
 import threading
 import time
@@ -83,11 +84,11 @@ class Link:
         self.lock = threading.RLock()       # the connection
         self.trace_lock = threading.Lock()  # plcweb's own use of the trace
         self.p = None
-        self.vars, self.by_path, self.table_key = [], {}, None
+        self.vars, self.by_path, self.table_key, self.table_time = [], {}, None, 0.0
         self.diag_cache, self.diag_time = None, 0.0
         self.wanted = {}                    # path -> last time a browser asked for it
         self.values, self.value_cycle, self.value_time = {}, None, 0.0
-        self.forced, self.watch_state = {}, "starting"
+        self.forced, self.watch_state, self.round_ms = {}, "starting", 0.0
         self.capture = {"state": "idle"}
         self.stop_ev = threading.Event()
         threading.Thread(target=self._watcher, daemon=True, name="watcher").start()
@@ -157,13 +158,19 @@ class Link:
         d["programs"] = sorted({".".join(v["path"].split(".")[:3]) for v in self.vars if v["path"].count(".") >= 2})
         d["watch_state"] = self.watch_state
         d["watching"] = len(self.wanted)
+        d["watch_round_ms"] = round(self.round_ms, 1)
         self.diag_cache, self.diag_time = d, now
         return d
 
     # ---- the variable table ----
     def table(self):
         """The program's variables [(path, type name, area)], read once per
-        program (again when plcrt restarts or the count changes)."""
+        program (again when plcrt restarts or the count changes: looked at
+        once a second)."""
+        if self.table_key and time.monotonic() - self.table_time < 1.0:
+            return self.vars
+        self.table_time = time.monotonic()
+
         def key(p):
             st = p.status()
             r = p.c.read_input_registers(DIAG + 38, 2, slave=1)
@@ -241,42 +248,97 @@ class Link:
             self.watch_state = "paused while a trace capture of this page runs"
             return
         try:
+            t0 = time.monotonic()
             vals, cycle = self.call(lambda p: self._sample(p, want))
+            self.round_ms = (time.monotonic() - t0) * 1000
         finally:
             self.trace_lock.release()
         self.values.update(vals)
         self.value_cycle, self.value_time = cycle, time.monotonic()
         self.watch_state = "ok"
 
+    def _pipeline(self, p, pdus):
+        """Requests sent together on plctrace's second connection, each reply
+        (function code, payload bytes) in order: one round trip for all."""
+        if not hasattr(p, "raw"):
+            p.windows([])                   # opens it
+        s = p.raw
+        s.sendall(b"".join(struct.pack(">HHHB", i, 0, len(pdu) + 1, 1) + pdu for i, pdu in enumerate(pdus)))
+        out, buf = [], bytearray()
+        while len(out) < len(pdus):
+            while not (len(buf) >= 6 and len(buf) >= 6 + (buf[4] << 8 | buf[5])):
+                # acknowledge at once: plcrt sends each reply as it is served, and a
+                # delayed ACK would hold the next one back by tens of ms (Nagle)
+                s.setsockopt(socket.IPPROTO_TCP, socket.TCP_QUICKACK, 1)
+                chunk = s.recv(65536)
+                if not chunk:
+                    raise Refused("plcrt closed the connection")
+                buf += chunk
+            n = 6 + (buf[4] << 8 | buf[5])
+            if (buf[0] << 8 | buf[1]) != len(out):
+                raise Refused("reply out of order")
+            out.append((buf[7], bytes(buf[8:n])))
+            del buf[:n]
+        return out
+
+    def _windows(self, p, reqs):
+        """The read-out window for each (what, first, count), as plctrace's
+        windows() reads them (FC 23, selector then window), in one round trip."""
+        pdus = [struct.pack(">BHHHHB3H", 23, plctrace.WIN, cnt, plctrace.SEL, 3, 6, what, first >> 16,
+                            first & 0xFFFF) for what, first, cnt in reqs]
+        out = []
+        for (what, first, _), (fc, payload) in zip(reqs, self._pipeline(p, pdus)):
+            if fc & 0x80:
+                raise Refused(f"window {what:#x}/{first}: exception {payload[0]}: "
+                              f"{plctrace.EXCEPTIONS.get(payload[0], '')}")
+            out.append(struct.unpack(f">{payload[0] // 2}H", payload[1:1 + payload[0]]))
+        return out
+
+    def _command_pdu(self, p, code, args=()):
+        regs = [p.token, code] + list(args)
+        return struct.pack(f">BHHB{len(regs)}H", 16, plctrace.CMD, len(regs), 2 * len(regs), *regs)
+
+    def _status_pdu(self):
+        return struct.pack(">BHH", 3, plctrace.BASE, 32)
+
+    @staticmethod
+    def _status_of(payload):
+        r = struct.unpack(f">{payload[0] // 2}H", payload[1:1 + payload[0]])
+        return {"readable": r[3], "captures": u32(r, 8), "seq": u32(r, 10)}
+
     def _sample(self, p, want):
         """One capture of one sample per chunk of 32 variables; the trace is
-        claimed for this alone and released."""
-        try:
-            p.command(plctrace.CLAIM, what="claim")
-        except Refused as e:
-            if "exception 6" in str(e):
-                raise Refused("waiting: another client (plctrace?) owns the trace, through which values are read")
-            raise
+        claimed for this alone and released. The commands of a chunk go in
+        one round trip (a refused claim makes the rest refused as well: they
+        carry a token that does not own the trace)."""
         vals, cycle = {}, None
         try:
             for k in range(0, len(want), 32):
                 chunk = want[k:k + 32]
-                p.command(plctrace.CHANNELS, [x for v in chunk for x in plctrace.args32(v["index"])], "channels")
-                p.command(plctrace.SETUP, [1, 0, 1, 0, 0, 0, 0xFFFF, 0xFFFF, 0, 0, 0, 0, 0], "setup")
-                st0 = p.status()
-                p.command(plctrace.ARM, what="arm")
-                p.command(plctrace.TRIGGER, what="trigger")
+                pdus = ([self._command_pdu(p, plctrace.CLAIM)] if k == 0 else []) + [
+                    self._command_pdu(p, plctrace.CHANNELS, [x for v in chunk for x in plctrace.args32(v["index"])]),
+                    self._command_pdu(p, plctrace.SETUP, [1, 0, 1, 0, 0, 0, 0xFFFF, 0xFFFF, 0, 0, 0, 0, 0]),
+                    self._status_pdu(),
+                    self._command_pdu(p, plctrace.ARM), self._command_pdu(p, plctrace.TRIGGER)]
+                replies = self._pipeline(p, pdus)
+                for fc, payload in replies:
+                    if fc & 0x80:
+                        if payload[0] == 6 and k == 0:
+                            raise Refused("waiting: another client (plctrace?) owns the trace, "
+                                          "through which values are read")
+                        raise Refused(f"watch: exception {payload[0]}: {plctrace.EXCEPTIONS.get(payload[0], '')}")
+                st0 = self._status_of(replies[-3][1])
                 end = time.monotonic() + 2
                 while True:
-                    st = p.status()
+                    st = self._status_of(self._pipeline(p, [self._status_pdu()])[0][1])
                     if st["readable"] and st["seq"] > st0["captures"]:
                         break
                     if time.monotonic() > end:
-                        p.command(plctrace.STOP, what="stop")
+                        self._pipeline(p, [self._command_pdu(p, plctrace.STOP)])
                         raise Refused("no sample within 2 s: is the scan running?")
-                    time.sleep(0.001)
+                    time.sleep(0.0005)
                 reqs = [(i, 0, 1 if v["size"] <= 2 else v["size"] // 2) for i, v in enumerate(chunk)]
-                wins = p.windows(reqs + [(plctrace.W_CYCLES, 0, 2)])
+                wins = self._windows(p, reqs + [(plctrace.W_CYCLES, 0, 2)])
                 for v, w in zip(chunk, wins):
                     raw = 0
                     for x in w:
@@ -284,7 +346,7 @@ class Link:
                     vals[v["path"].upper()] = plctrace.decode(raw, v["tcode"])
                 cycle = u32(wins[-1], 0)
         finally:
-            p.command(plctrace.RELEASE, what="release")
+            self._pipeline(p, [self._command_pdu(p, plctrace.RELEASE)])
         return vals, cycle
 
     # ---- writes ----

@@ -56,7 +56,8 @@ const OV = [
   ["Modbus clients", "clients"], ["requests served", "requests"], ["exceptions sent", "exceptions"],
   ["retain saves (failures)", ["retain_saves", "retain_failures"]], ["forced variables", "forced"],
   ["forcing allowed", "force_allowed"], ["I/O errors", "io_errors"], ["trace", "trace_state"],
-  ["variables", "nvars"], ["up (s)", "uptime_s"], ["watch", "watch_state"]];
+  ["variables", "nvars"], ["up (s)", "uptime_s"], ["watch", "watch_state"],
+  ["variables watched, ms the trace is held per sample", ["watching", "watch_round_ms"]]];
 async function overview() {
   $("ov-plc").textContent = "plcrt at " + session.plc;
   const t = $("ov-table");
@@ -76,8 +77,8 @@ async function overview() {
     const b = $("ov-backend");
     b.textContent = "";
     const h = b.insertRow();
-    ["sim axis", "position (counts)", "speed (counts/s)"].forEach(x => h.appendChild(el("th", x)));
-    for (const a of d.backend.filter(a => a.position || a.speed)) {
+    ["sim axis (registers 1088-1151)", "position (counts)", "speed (counts/s)"].forEach(x => h.appendChild(el("th", x)));
+    for (const a of d.backend.filter(a => a.axis === 0 || a.position || a.speed)) {
       const r = b.insertRow();
       [a.axis, a.position, a.speed].forEach(x => r.insertCell().textContent = x);
     }
