@@ -13,6 +13,7 @@ it in between). Every value of one capture comes from the same cycle. The
 protocol code is plctrace's own (plc_runtime/plctrace), imported, not copied.
 """
 import importlib.machinery
+import logging
 import importlib.util
 import os
 import shutil
@@ -22,6 +23,8 @@ import threading
 import time
 
 HERE = os.path.dirname(os.path.realpath(__file__))
+log = logging.getLogger("plcweb")
+logging.getLogger("pymodbus").setLevel(logging.CRITICAL)   # plcweb says it once, in words
 
 
 def _load_plctrace():
@@ -88,7 +91,7 @@ class Link:
         self.diag_cache, self.diag_time = None, 0.0
         self.wanted = {}                    # path -> last time a browser asked for it
         self.values, self.value_cycle, self.value_time = {}, None, 0.0
-        self.forced, self.watch_state, self.round_ms = {}, "starting", 0.0
+        self.forced, self.watch_state, self.round_ms, self.logged_state = {}, "starting", 0.0, "ok"
         self.capture = {"state": "idle"}
         self.stop_ev = threading.Event()
         threading.Thread(target=self._watcher, daemon=True, name="watcher").start()
@@ -99,6 +102,9 @@ class Link:
             try:
                 self.p = plctrace.Plc(self.host, self.port)
             except SystemExit as e:
+                if "cannot connect" in str(e):
+                    raise Refused(f"plcrt at {self.host}:{self.port} does not answer: is it running, on this "
+                                  "port (plcweb --plc HOST:PORT)?") from None
                 raise Refused(str(e).replace("plctrace: ", "")) from None
         return self.p
 
@@ -115,7 +121,10 @@ class Link:
         with self.lock:
             try:
                 return fn(self.plc())
-            except Refused:
+            except Refused as e:
+                if "exception None" in str(e) or "Modbus Error" in str(e):    # no reply: not a refusal
+                    self.drop()
+                    raise Refused(f"plcrt at {self.host}:{self.port} does not answer: is it running?") from None
                 raise
             except (OSError, AttributeError, struct.error) as e:
                 self.drop()
@@ -137,7 +146,7 @@ class Link:
         def read(p):
             r = p.c.read_input_registers(DIAG, 50, slave=1)
             if r.isError():
-                raise Refused(f"diagnostics: {r}")
+                raise Refused(f"diagnostics: exception {getattr(r, 'exception_code', None)}: {r}")
             b = p.c.read_input_registers(1088, 64, slave=1)
             return r.registers, (b.registers if not b.isError() else []), p.status()
         regs, backend, st = self.call(read)
@@ -232,6 +241,9 @@ class Link:
             except Exception as e:     # never let the thread die
                 self.watch_state = f"watcher: {type(e).__name__}: {e}"
                 self.drop()
+            if self.watch_state != self.logged_state:      # said once, not 20 times a second
+                log.info("watch: %s", self.watch_state)
+                self.logged_state = self.watch_state
             self.stop_ev.wait(max(0.0, 1.0 / self.rate - (time.monotonic() - t0)))
 
     def _watch_round(self, now):

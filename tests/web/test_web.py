@@ -78,8 +78,8 @@ class Mb:
 class Http:
     """plain HTTP to plcweb, with or without a session"""
 
-    def __init__(self, port):
-        self.port, self.cookie, self.csrf = port, None, None
+    def __init__(self, port, work=None):
+        self.port, self.cookie, self.csrf, self.work = port, None, None, work
 
     def req(self, method, path, body=None, csrf=True, headers=None):
         c = http.client.HTTPConnection("127.0.0.1", self.port, timeout=30)
@@ -221,13 +221,14 @@ def main():
             raise RuntimeError("plcweb does not listen")
         mb = Mb(port)
         wait_for(lambda: mb.coil(C_LOOPON), 20, 0.05)
-        security(wport, mb)
+        security(wport, mb, work)
         drv = browser()
         pages(drv, wport, mb, port, shots, work)
         project(drv, wport, work, port, shots)
         viewer(drv, wport, shots)
         throttle(wport)
         reachable(wport)
+        plcrt_gone(wport, svc)
         log = open(os.path.join(work, "writes.log")).read()
         report("every write is logged with its user: olga's force, unforce, write and axis stop",
                all(f"olga: {w}" in log for w in ("force", "unforce", "write", "axis")), log[-800:])
@@ -241,7 +242,7 @@ def main():
     return 0 if report.all_passed() else 1
 
 
-def security(wport, mb):
+def security(wport, mb, work):
     before = mb.md(SPEED)
     anon = Http(wport)
     st, _ = anon.req("POST", "/api/write", {"path": "CONFIG0.RES0.AXIS.SLVELASSE", "value": "77"})
@@ -259,7 +260,7 @@ def security(wport, mb):
            results == [403] * 6 and mb.md(SPEED) == before and mb.diag(FORCED) == 0, f"{results}")
     st, _ = v.req("GET", "/api/overview")
     report("a viewer reads: the overview answers", st == 200, st)
-    o = Http(wport)
+    o = Http(wport, os.path.join(work, "projects"))
     o.login("olga", "olga-secret-1")
     st, body = o.req("POST", "/api/write", {"path": "CONFIG0.RES0.AXIS.SLVELASSE", "value": "77"}, csrf=False)
     st2, _ = o.req("POST", "/api/write", {"path": "CONFIG0.RES0.AXIS.SLVELASSE", "value": "77"},
@@ -271,7 +272,22 @@ def security(wport, mb):
            st == 200 and wait_for(lambda: mb.md(SPEED) == 77, 5, 0.02)
            and wait_for(lambda: mb.diag(FORCED) == 0, 5, 0.02),
            f"{st} {body[:200]} {mb.md(SPEED)}")
+    st, body = o.req("POST", "/api/write", {"path": "CONFIG0.RES0.AXIS.SLVELASSE", "value": "78"},
+                     headers={"Origin": "http://elsewhere.example"})
+    report("a write sent by another site's page (its Origin), cookie and token included: 403, nothing written",
+           st == 403 and mb.md(SPEED) == 77, f"{st} {body[:200]} {mb.md(SPEED)}")
     o.req("POST", "/api/write", {"path": "CONFIG0.RES0.AXIS.SLVELASSE", "value": str(before)})
+    evil = io.BytesIO()
+    with tarfile.open(fileobj=evil, mode="w:gz") as t:
+        for name in ("proj/plcrt.ini", "proj/main.st", "../../outside.st"):
+            ti = tarfile.TarInfo(name)
+            ti.size = 3
+            t.addfile(ti, io.BytesIO(b"(**)"[:3]))
+    st, body = o.req("POST", "/api/project", evil.getvalue(), headers={"X-Filename": "evil.tar.gz"})
+    res = json.loads(body) if st == 200 else {}
+    report("an archive with a path leaving the project folder: refused, naming it; nothing written outside",
+           st == 200 and res.get("state") == "failed" and "../../outside.st" in res.get("summary", "")
+           and not os.path.exists(os.path.join(o.work, "..", "outside.st")), f"{st} {body[:300]}")
     st, body = o.req("POST", "/api/force", {"path": "CONFIG0.RES0.AXIS.SLVELASSE", "value": "12.5"})
     report("a force of 12.5 into a DINT: refused in plctrace's words", st == 409 and b"is not an integer" in body,
            f"{st} {body[:200]}")
@@ -529,6 +545,19 @@ def throttle(wport):
            codes == [401] * 3 and st == 429 and b"wait" in body, f"{codes} {st} {body[:100]}")
     ok = wait_for(lambda: h.login("olga", "olga-secret-1")[0] == 200, 10, 0.5)
     report("after the wait the right password logs in", ok, f"{time.monotonic() - t0:.1f} s")
+
+
+def plcrt_gone(wport, svc):
+    h = Http(wport)
+    h.login("olga", "olga-secret-1")
+    svc.plc.stop()
+    st, body = h.req("GET", "/api/overview")
+    _, vals = h.req("GET", "/api/values?p=CONFIG0.RES0.WEBTEST.N")
+    state = wait_for(lambda: "does not answer" in json.loads(h.req("GET", "/api/values?p=CONFIG0.RES0.WEBTEST.N")[1])
+                     ["state"], 5, 0.1)
+    report("plcrt stopped: the overview and the watch list say plcrt does not answer; plcweb runs on",
+           st == 502 and b"does not answer" in body and state and h.req("GET", "/api/session")[0] == 200,
+           f"{st} {body[:200]} {vals[:200]}")
 
 
 def reachable(wport):
