@@ -69,9 +69,6 @@ AXIS_KINDS = [
       "position": "POS", "setpoint": "CMDPOS", "folerr": ("CMDPOS", "POS"), "speed": "VEL", "output": None,
       "errors": ["AXISERR", "POWERR"], "stop": None, "reset": None}),
 ]
-PLCOPEN_STATES = ["Disabled", "Standstill", "Homing", "DiscreteMotion", "ContinuousMotion",
-                  "SynchronizedMotion", "Stopping", "ErrorStop"]
-APOSS_MODES = ["idle", "positioning", "constant speed", "stopping", "homing"]
 
 
 def u32(r, i):

@@ -87,7 +87,12 @@ async function overview() {
 }
 
 // ---- Variables ----
-function watchList() { try { return JSON.parse(localStorage.getItem("plcweb.watch") || "[]"); } catch (e) { return []; } }
+function watchList() {
+  let w;
+  try { w = JSON.parse(localStorage.getItem("plcweb.watch") || "[]"); } catch (e) { w = []; }
+  const seen = new Set();      // each variable once, whatever was stored
+  return (Array.isArray(w) ? w : []).filter(v => v && typeof v.path === "string" && !seen.has(v.path) && seen.add(v.path));
+}
 function saveWatch(w) { localStorage.setItem("plcweb.watch", JSON.stringify(w)); }
 function addWatch(v) {
   const w = watchList();
@@ -157,9 +162,9 @@ async function variables() {
   drawWatch();
   every(100, () => pollValues(watchList().map(v => v.path), d => {
     $("watch-state").textContent = d.state === "ok" ? `cycle ${d.cycle}, ${d.age_ms} ms ago` : d.state;
-    for (const [p, v] of Object.entries(d.values)) {
-      const r = $(rowId(p));
-      if (!r) continue;
+    for (const r of $("watch").tBodies[0].rows) {
+      const p = r.dataset.path, v = d.values[p];
+      if (!(p in d.values)) continue;
       r.cells[2].textContent = fmt(v);
       const f = d.forced[p];
       r.classList.toggle("forced", f !== null && f !== undefined);
