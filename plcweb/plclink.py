@@ -85,6 +85,7 @@ class Link:
         self.trace_lock = threading.Lock()  # plcweb's own use of the trace
         self.p = None
         self.vars, self.by_path, self.table_key, self.table_time = [], {}, None, 0.0
+        self.generation = 0                 # counts the variable tables read: a new program
         self.diag_cache, self.diag_time = None, 0.0
         self.wanted = {}                    # path -> last time a browser asked for it
         self.values, self.value_cycle, self.value_time = {}, None, 0.0
@@ -98,6 +99,7 @@ class Link:
         if self.p is None:
             try:
                 self.p = plctrace.Plc(self.host, self.port)
+                self.table_time = 0.0           # a new connection: perhaps another program
             except SystemExit as e:
                 if "cannot connect" in str(e):
                     raise Refused(f"plcrt at {self.host}:{self.port} does not answer: is it running, on this "
@@ -195,6 +197,7 @@ class Link:
         self.vars = self.call(read)
         self.by_path = {v["path"].upper(): v for v in self.vars}
         self.table_key = k
+        self.generation += 1
         return self.vars
 
     def resolve(self, path):
@@ -226,7 +229,7 @@ class Link:
         return {"values": {p: self.values.get(p.upper()) for p in paths},
                 "forced": {p: self.forced.get(p.upper()) for p in paths},
                 "cycle": self.value_cycle, "age_ms": round((now - self.value_time) * 1000) if self.value_time else None,
-                "state": self.watch_state}
+                "state": self.watch_state, "program": self.generation}
 
     def _watcher(self):
         while not self.stop_ev.is_set():
@@ -427,6 +430,10 @@ class Link:
                             f[k] = None
                     found.append({"kind": kind, "path": head, "fields": f})
                     break
+        # an adapter that mirrors its device's members (MC_AXIS_EPICPOS and its
+        # Dev) is one axis: the device inside it is shown
+        found = [a for a in found if not any(b is not a and b["kind"] == a["kind"]
+                                             and b["path"].startswith(a["path"] + ".") for b in found)]
         # A program that copies its own command variable into the block's
         # input every cycle (the examples' cSTOP -> Axis.STOP) overwrites a
         # forced input before the block runs: there the command goes through

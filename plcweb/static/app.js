@@ -129,10 +129,12 @@ function drawWatch() {
     acts.appendChild(x);
   }
 }
+let program = null;
 async function pollValues(paths, show) {
-  if (!paths.length) return;
   const q = paths.map(p => "p=" + encodeURIComponent(p)).join("&");
   const d = await api("GET", "/api/values?" + q);
+  if (program !== null && d.program !== program) { location.reload(); return; }   // another program runs
+  program = d.program;
   show(d);
 }
 async function variables() {
@@ -197,7 +199,7 @@ async function axes() {
       const src = a.fields[k];
       if (!src) continue;
       const r = t.insertRow();
-      r.insertCell().textContent = label;
+      r.insertCell().textContent = k === "mode" && a.kind === "PLCopen" ? "state" : label;
       const c = r.insertCell(); c.className = "value " + k; c.textContent = "…";
       c.dataset.src = JSON.stringify(src);
       c.dataset.kind = a.kind;

@@ -196,6 +196,7 @@ def main():
     ap.add_argument("ini")
     ap.add_argument("work")
     ap.add_argument("shots", nargs="?")
+    ap.add_argument("--plcopen", nargs=2, metavar=("PLCRT", "INI"), help="the PLCopen example, for its axes")
     a = ap.parse_args()
     work = os.path.abspath(a.work)
     shots = os.path.abspath(a.shots or os.path.join(work, "shots"))
@@ -229,6 +230,8 @@ def main():
         throttle(wport)
         reachable(wport)
         plcrt_gone(wport, svc)
+        if a.plcopen:
+            plcopen_axes(drv, wport, port, a.plcopen, work, shots)
         log = open(os.path.join(work, "writes.log")).read()
         report("every write is logged with its user: olga's force, unforce, write and axis stop",
                all(f"olga: {w}" in log for w in ("force", "unforce", "write", "axis")), log[-800:])
@@ -561,6 +564,34 @@ def plcrt_gone(wport, svc):
     report("plcrt stopped: the overview and the watch list say plcrt does not answer; plcweb runs on",
            st == 502 and b"does not answer" in body and state and h.req("GET", "/api/session")[0] == 200,
            f"{st} {body[:200]} {vals[:200]}")
+
+
+PLCOPEN_STATES = ["Disabled", "Standstill", "Homing", "DiscreteMotion", "ContinuousMotion",
+                  "SynchronizedMotion", "Stopping", "ErrorStop"]
+
+
+def plcopen_axes(drv, wport, port, plcopen, work, shots):
+    """Another program on the same port: plcweb reads its variables anew;
+    the PLCopen example's axes (docs/examples.md: state of X at %MD10)."""
+    ini = os.path.join(work, "plcopen.ini")
+    make_ini(plcopen[1], ini, port, os.path.join(work, "plcopen.retain"))
+    Plcrt(plcopen[0], ini, work, "plcopen")
+    mb = Mb(port)
+    drv.get(f"http://127.0.0.1:{wport}/axes")
+    panels = wait_for(lambda: len(drv.find_elements(By.CSS_SELECTOR, ".axis")) == 4
+                      and drv.find_elements(By.CSS_SELECTOR, ".axis"), 15, 0.2)
+    titles = sorted(p.find_element(By.TAG_NAME, "h3").text for p in panels or [])
+    report("another program on the port: its axes, PLCopen X and Y and their EPICPOS devices (adapters not twice)",
+           titles == ["EPICPOS MC.DRVX.DEV", "EPICPOS MC.DRVY.DEV", "PLCopen MC.AXISX", "PLCopen MC.AXISY"],
+           f"{titles} {text(drv, 'axes')[:200]} {text(drv, 'message')}")
+    if not panels:
+        return
+    x = "axis-CONFIG0_RES0_MC_AXISX"
+    same = wait_for(lambda: drv.find_element(By.CSS_SELECTOR, f"#{x} td.mode").text
+                    == PLCOPEN_STATES[mb.md(MD + 20)], 10, 0.05)
+    report("PLCopen X's state by name, the one the example publishes at %MD10 (pymodbus)", same,
+           f"{drv.find_element(By.CSS_SELECTOR, f'#{x} td.mode').text} {mb.md(MD + 20)}")
+    drv.save_screenshot(os.path.join(shots, "web-axes-plcopen.png"))
 
 
 def reachable(wport):

@@ -5,13 +5,14 @@
 # screenshots of docs/web.md into docs/img.
 WEB_T := $(BUILD)/tests/web
 .PHONY: test-web web-screenshots
-test-web: $(BUILD)/plc/epicpos/plcrt plcrt-parts
+WEB_PLCOPEN = --plcopen $(BUILD)/plc/plcopen/plcrt examples/plcopen/plcopen.ini
+test-web: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/plcopen/plcrt plcrt-parts
 	@rm -rf $(WEB_T) && mkdir -p $(WEB_T)
 	@mk/suite.sh $(RESULTS) web python3 tests/web/test_web.py \
-	    $(BUILD)/plc/epicpos/plcrt examples/epicpos/epicpos.ini $(abspath $(WEB_T))
+	    $(BUILD)/plc/epicpos/plcrt examples/epicpos/epicpos.ini $(abspath $(WEB_T)) $(WEB_PLCOPEN)
 TESTS += test-web
 
-web-screenshots: $(BUILD)/plc/epicpos/plcrt plcrt-parts
+web-screenshots: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/plcopen/plcrt plcrt-parts
 	@rm -rf $(WEB_T) && mkdir -p $(WEB_T)
 	@python3 tests/web/test_web.py $(BUILD)/plc/epicpos/plcrt examples/epicpos/epicpos.ini \
-	    $(abspath $(WEB_T)) $(abspath docs/img)
+	    $(abspath $(WEB_T)) $(abspath docs/img) $(WEB_PLCOPEN)
