@@ -391,7 +391,13 @@ class Link:
         if v["path"].upper() in {p.upper() for p, _, _ in self.forced_now()}:
             raise Refused(f"{v['path']} is forced: unforce it first, or force the new value")
         c0, n0 = self.cycles_and_forced()
-        self.force(v["path"], value)
+        try:
+            self.force(v["path"], value)
+        except Refused as e:
+            if "exception 1" in str(e):
+                raise Refused(f"write {v['path']}: plcrt writes a program variable by forcing it for two cycles, "
+                              "and its configuration does not allow forcing: [debug] allow_force = yes") from None
+            raise
         try:
             # the scan has taken the force when its count shows it; then two cycles more
             end = time.monotonic() + 5
@@ -457,7 +463,10 @@ class Link:
         cmd = ax["fields"].get(action)
         if not cmd:
             raise Refused(f"{ax['kind']} axis {path}: no {action} command here (the program's MC_Stop/MC_Reset)")
-        return self.write(cmd, "TRUE")
+        try:
+            return self.write(cmd, "TRUE")
+        except Refused as e:
+            raise Refused(f"{action} {ax['kind']} {path}: {e}") from None
 
     # ---- trace captures ----
     def start_capture(self, chans, trigger, pre, samples, every, timeout=60.0):
