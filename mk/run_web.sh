@@ -4,7 +4,7 @@
 # configuration, prints its address and a login, and stops it when COMMAND
 # ends. The first run writes a user `demo` (operator) with a random password
 # into build/plcweb.users (the password in build/plcweb.password). plcweb
-# runs in a session of its own: Ctrl-C still reaches plcrt alone.
+# ignores Ctrl-C (it is plcrt's to take) and ends with this script.
 # WEB_PORT: plcweb's HTTP port (default 8080).
 set -u
 ini= prev=
@@ -18,8 +18,9 @@ if [ ! -s "$users" ] || [ ! -s "$pwfile" ]; then
     python3 plcweb/plcweb adduser --users "$users" demo operator < "$pwfile" > /dev/null
 fi
 : > "$weblog"
-setsid python3 plcweb/plcweb --users "$users" --port "${WEB_PORT:-8080}" --plc "127.0.0.1:${port:-1502}" \
-    --project-dir build/plcweb-projects --log build/plcweb-writes.log > "$weblog" 2>&1 < /dev/null &
+(trap '' INT QUIT; exec python3 plcweb/plcweb --users "$users" --port "${WEB_PORT:-8080}" \
+    --plc "127.0.0.1:${port:-1502}" --project-dir build/plcweb-projects --log build/plcweb-writes.log) \
+    > "$weblog" 2>&1 < /dev/null &
 web=$!
 trap 'kill $web 2>/dev/null' EXIT
 for _ in $(seq 50); do
