@@ -16,3 +16,11 @@ web-screenshots: $(BUILD)/plc/epicpos/plcrt $(BUILD)/plc/plcopen/plcrt plcrt-par
 	@rm -rf $(WEB_T) && mkdir -p $(WEB_T)
 	@python3 tests/web/test_web.py $(BUILD)/plc/epicpos/plcrt examples/epicpos/epicpos.ini \
 	    $(abspath $(WEB_T)) $(abspath docs/img) $(WEB_PLCOPEN)
+
+# `make run` starts plcweb beside plcrt and prints its address and a login.
+.PHONY: test-web-make-run
+test-web-make-run: $(BUILD)/plc/epicpos/plcrt
+	@rm -rf $(BUILD)/tests/web-make-run && mkdir -p $(BUILD)/tests/web-make-run
+	@mk/suite.sh $(RESULTS) web-make-run python3 tests/web/test_make_run.py . examples/epicpos/epicpos.ini \
+	    $(abspath $(BUILD))/tests/web-make-run
+TESTS += test-web-make-run
