@@ -202,6 +202,8 @@ class Link:
 
     def resolve(self, path):
         """A variable by its full path or unique tail, as plcrt's LOOKUP does."""
+        if not path.strip():
+            raise Refused("give a variable's path (or its unique tail, e.g. axis.posit)")
         self.table()
         v = self.by_path.get(path.upper())
         if v:

@@ -177,7 +177,8 @@ async function variables() {
 
 // ---- Axes ----
 async function axes() {
-  const list = await api("GET", "/api/axes");
+  const got = await api("GET", "/api/axes"), list = got.axes;
+  program = got.program;       // the program these axes belong to: another one reloads the page
   const box = $("axes");
   if (!list.length) box.textContent = "No EPICPOS, APOSS or PLCopen axis in this program.";
   const paths = [];

@@ -280,6 +280,13 @@ def security(wport, mb, work):
     report("a write sent by another site's page (its Origin), cookie and token included: 403, nothing written",
            st == 403 and mb.md(SPEED) == 77, f"{st} {body[:200]} {mb.md(SPEED)}")
     o.req("POST", "/api/write", {"path": "CONFIG0.RES0.AXIS.SLVELASSE", "value": str(before)})
+    st, body = o.req("POST", "/api/force", "[1, 2]", headers={"Content-Type": "application/json"})
+    st2, body2 = o.req("POST", "/api/force", "{not json", headers={"Content-Type": "application/json"})
+    st3, body3 = o.req("POST", "/api/write", "x" * 100, headers={"Content-Length": "999999999"})
+    st4, _ = o.req("GET", "/api/overview")
+    report("bad requests (a JSON list, broken JSON, a body claimed of 1 GB): refused in words, plcweb runs on",
+           st == 409 and b"give a variable" in body and st2 == 409 and st3 == 413 and st4 == 200,
+           f"{st} {body[:100]} {st2} {body2[:100]} {st3} {body3[:100]} {st4}")
     evil = io.BytesIO()
     with tarfile.open(fileobj=evil, mode="w:gz") as t:
         for name in ("proj/plcrt.ini", "proj/main.st", "../../outside.st"):
