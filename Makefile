@@ -87,7 +87,7 @@ run:
 	@mk/deps.sh
 ifeq ($(PROJECT),)
 	@$(MAKE) --no-print-directory all
-	@$(MAKE) --no-print-directory $(RUN_DEMO)
+	@$(MAKE) --no-print-directory $(RUN_DEMO) RUN_WEB=mk/run_web.sh
 else
 	@./plcrt-build --run $(PROJECT)
 endif

@@ -90,3 +90,11 @@ bench-aposs: $(STC) $(ST_LIB) $(BUILD)/plc/aposs/plcrt
 	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
 	  bench/aposs/bench.sh $(BENCH_B)/aposs $(abspath $(ST_LIB)) 3000 5 $(abspath $(BUILD)/plc/aposs/plcrt)
 BENCHES += bench-aposs
+
+# plcweb: plcrt's overruns and exec p99 alone and while 10 clients watch 50
+# variables each at 10 Hz through plcweb (bench/web/)
+.PHONY: bench-web
+bench-web: $(BUILD)/plc/epicpos/plcrt
+	@mkdir -p $(BENCH_B)/web
+	python3 bench/web/bench.py $(BUILD)/plc/epicpos/plcrt examples/epicpos/epicpos.ini $(abspath $(BENCH_B))/web
+BENCHES += bench-web

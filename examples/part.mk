@@ -19,7 +19,7 @@ ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 
 .PHONY: $(EXAMPLES:%=run-%)
 $(EXAMPLES:%=run-%): run-%: $(BUILD)/plc/%/plcrt
-	@mk/run_fg.sh $(BUILD)/plc/$*/plcrt -c $(or $(INI),examples/$*/$*.ini)
+	@$(RUN_WEB) mk/run_fg.sh $(BUILD)/plc/$*/plcrt -c $(or $(INI),examples/$*/$*.ini)
 RUN_DEMO := run-epicpos
 # remote I/O (docs/remote-io.md): two pymodbus modules beside plcrt
 $(eval $(call plcrt_program,remoteio,examples/remoteio/remoteio.st))

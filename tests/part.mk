@@ -45,3 +45,5 @@ include tests/cam/cam.mk
 include tests/getting_started/getting_started.mk
 # ---- the scripts that make the docs' plots ----
 include tests/docs/docs.mk
+# ---- plcweb: the web page in a headless browser, its security ----
+include tests/web/web.mk
