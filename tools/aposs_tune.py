@@ -20,7 +20,7 @@ whatever the host's load.  The steps (docs/aposs.md, "Tuning"):
      KPROP = 70 % of the onset
   6  KDER: 200, then 1.5 times more per run until the oscillation (RMS of
      the following error about its mean, move and standstill) rises, more
-     than 15 % above the lowest so far; the last value before is kept
+     than 10 % above the lowest so far; the last value before is kept
   7  KINT: only if a static following error (above 1 qc) remains
   9  BANDWIDTH: from just above what the PID used, lowered by 30 % per run
      while the following error (its RMS and its peak) stays within 10 % of
@@ -396,12 +396,12 @@ class Tuner:
         while kd <= 65000:
             c = self.run("6", d_plat, 0.3, True, KDER=kd)
             m = self.oscillation(c)
-            # a change within 15 % is the encoder's rounding (where within a
+            # a change within 10 % is the encoder's rounding (where within a
             # count the run started), not the gain's: the oscillations rise
             # when they exceed the lowest so far by more
-            rise = m > 1.15 * lowest
+            rise = m > 1.1 * lowest
             log(f"step 6 run {self.runs}: KDER {kd}: oscillation {m:.3f} qc"
-                + (f" (more than 15 % above the lowest, {lowest:.3f}: they rise)" if rise else ""))
+                + (f" (more than 10 % above the lowest, {lowest:.3f}: they rise)" if rise else ""))
             if rise:
                 break
             last, lowest = (m, kd, c), min(lowest, m)
