@@ -240,8 +240,6 @@ def main():
                 peaks[who].append(max(abs(x) for x in fe))
         print("standard move, peak following error (qc): tool " + " ".join(f"{x:.3f}" for x in peaks["tool"])
               + "; hand tune " + " ".join(f"{x:.3f}" for x in peaks["hand"]), flush=True)
-        print("standard move, peak following error (qc): tool " + " ".join(f"{x:.3f}" for x in peaks["tool"])
-              + "; hand tune " + " ".join(f"{x:.3f}" for x in peaks["hand"]), flush=True)
         print(f"standard move: the tool's peak at most 1.10 qc in {sum(p <= 1.10 + 1e-5 for p in peaks['tool'])} "
               f"of 5 runs, the hand tune's in {sum(p <= 1.10 + 1e-5 for p in peaks['hand'])} of 5", flush=True)
         # one count of the encoder is in every peak (FE = CPOS - the counter)
@@ -250,7 +248,9 @@ def main():
         # runs above differ by their starts as much as by their gains.  The
         # comparison is made on the same 32 starts, 1/32 qc apart, on the
         # example's plant in an ST program (stdmove.st.in)
+        ax.mb.close()       # an idle client would be dropped meanwhile
         fig = stdmove(fileg, work)
+        ax = Axis(port)
         print("standard move, mean of 32 starts (qc): tool %.3f (worst %.3f), hand tune %.3f (worst %.3f)"
               % tuple(fig.get(k, 0) / 1000 for k in ("tool_mean", "tool_worst", "hand_mean", "hand_worst")),
               flush=True)
