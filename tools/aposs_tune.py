@@ -20,11 +20,13 @@ whatever the host's load.  The steps (docs/aposs.md, "Tuning"):
      KPROP = 70 % of the onset
   6  KDER: 200, then 1.5 times more per run until the oscillation (RMS of
      the following error about its mean, move and standstill) rises, more
-     than 15 % above the lowest so far; the last value before is kept
+     than 10 % above the lowest so far; of the values before whose
+     oscillation is within 10 % of the lowest (a bottom flat to the
+     encoder), the middle one is kept
   7  KINT: only if a static following error (above 1 qc) remains
-  9  BANDWIDTH: from just above what the PID used, lowered by 30 % per run
+  9  BANDWIDTH: from 1.25 times what the PID used, lowered by 20 % per run
      while the following error (its RMS and its peak) stays within 10 % of
-     its best
+     its best, not below what the PID used
  10  POSERR back; a last run of the standard move (--dist) shows the result
 
 Each step's run is the shortest move that shows what it measures: one that
@@ -392,25 +394,33 @@ class Tuner:
         c = self.run("6", d_plat, 0.3, True, KPROP=self.kprop, KDER=0, KINT=0)     # step 6
         best = (self.oscillation(c), 0, c)
         log(f"step 6 run {self.runs}: KDER 0: oscillation {best[0]:.3f} qc")
-        kd, last, lowest = 200, best, best[0]
+        tried = [best]
+        kd, lowest = 200, best[0]
         while kd <= 65000:
             c = self.run("6", d_plat, 0.3, True, KDER=kd)
             m = self.oscillation(c)
-            # a change within 15 % is the encoder's rounding (where within a
+            # a change within 10 % is the encoder's rounding (where within a
             # count the run started), not the gain's: the oscillations rise
             # when they exceed the lowest so far by more
-            rise = m > 1.15 * lowest
+            rise = m > 1.1 * lowest
             log(f"step 6 run {self.runs}: KDER {kd}: oscillation {m:.3f} qc"
-                + (f" (more than 15 % above the lowest, {lowest:.3f}: they rise)" if rise else ""))
+                + (f" (more than 10 % above the lowest, {lowest:.3f}: they rise)" if rise else ""))
             if rise:
                 break
-            last, lowest = (m, kd, c), min(lowest, m)
+            tried.append((m, kd, c))
+            lowest = min(lowest, m)
             kd = round(kd * 1.5)
-        best = last
+        # the values before the rise whose oscillation is within 10 % of the
+        # lowest are one flat bottom to the encoder: the middle one is kept,
+        # as far from too little damping as from a KDER that multiplies the
+        # encoder's counts
+        bottom = [t for t in tried if t[0] <= 1.1 * lowest]
+        best = bottom[len(bottom) // 2]
+        log(f"step 6: KDER {', '.join(str(t[1]) for t in bottom)} within 10 % of the lowest: the middle one")
         self.kder = best[1]
         self.steps["6"] = best[2]
         ax.set("KDER", self.kder)
-        log(f"step 6: KDER {self.kder}, the last value before the oscillations rose")
+        log(f"step 6: KDER {self.kder}")
 
         _, _, static = self.standstill(best[2])                              # step 7
         self.kint = 0
@@ -425,13 +435,18 @@ class Tuner:
 
         ref = self.steps.get("7", best[2])
         fe_best, pk_best = self.oscillation(ref), self.fe_peak(ref)
-        peak = max(abs(x) for x in ref["PIDPART"])
+        peak = max(abs(x) for r in both(ref) for x in r["PIDPART"])
+        # the floor: what the PID used there and back; below it the clamp
+        # cuts the corrections of the runs measured, and those of other
+        # starts more (the seed expects 60..120 with a good feed-forward)
+        floor = max(1, min(1000, math.ceil(1000 * peak / 32767)))
         bw = max(1, min(1000, math.ceil(1.25 * 1000 * peak / 32767)))
         log(f"step 9: the PID used at most {peak:.0f} DAC bits ({1000 * peak / 32767:.1f} / 1000): "
-            f"BANDWIDTH {bw} clamps nothing; following error {fe_best:.3f} qc RMS, {pk_best:.3f} qc peak")
+            f"BANDWIDTH {bw} clamps nothing, {floor} is the floor; following error {fe_best:.3f} qc RMS, "
+            f"{pk_best:.3f} qc peak")
         good = bw
-        while bw > 1:
-            bw = max(1, math.floor(bw * 0.7))
+        while bw > floor:
+            bw = max(floor, math.floor(bw * 0.8))
             c = self.run("9", d_plat, 0.3, True, BANDWIDTH=bw)
             m, pk = self.oscillation(c), self.fe_peak(c)
             # the following error, its RMS and its peak, within 10 % of the best

@@ -55,15 +55,17 @@ awk -v m1="$med1" -v m="$med256" -v p="$p99256" -v x="$max256" 'BEGIN {
 d="$out/gains"
 rm -rf "$d" && mkdir -p "$d"
 if [ -n "$plcrt" ]; then
-    python3 "$top/tests/apossaxis/test_tune.py" "$plcrt" "$top/examples/aposs/aposs.ini" "$d/tune" > "$d/tune.log" 2>&1
+    ST_LIB="$lib" python3 "$top/tests/apossaxis/test_tune.py" "$plcrt" "$top/examples/aposs/aposs.ini" "$d/tune" > "$d/tune.log" 2>&1
+    trc=$?
     gl=$(sed -n 's/^gains: //p' "$d/tune/tune.out" 2>/dev/null)
     [ -n "$gl" ] || { echo "bench-aposs: FAIL: the tuning run gave no gains:"; tail -5 "$d/tune.log"; exit 1; }
     echo "bench-aposs: tuning tool on examples/aposs: $gl"
     sed -n 's/^\(step [0-9]*: .*\|[0-9]* test runs, .*\)$/bench-aposs:   \1/p' "$d/tune/tune.out"
     # the test's own measures: the onset, and the standard move beside the hand tune's
-    sed -n 's/^\(standard move, .*\|oscillation onset .*\|the loop.s linear .*\)$/bench-aposs: \1/p' "$d/tune.log"
+    sed -n 's/^\(standard move.*\|oscillation onset .*\|the loop.s linear .*\)$/bench-aposs: \1/p' "$d/tune.log"
     grep -c '^PASS' "$d/tune.log" | sed 's/^/bench-aposs: tuning test checks passed: /'
     grep '^FAIL' "$d/tune.log" | sed 's/^/bench-aposs: /'
+    [ "$trc" = 0 ] || echo "bench-aposs: FAIL: the tuning test ended with status $trc: $(tail -1 "$d/tune.log")"
 else
     echo "bench-aposs: no plcrt given: the tuning tool's gains of docs/aposs.md are used"
     gl="FFVEL 875 FFACC 24 KPROP 466 KDER 1012 KINT 0 BANDWIDTH 34"

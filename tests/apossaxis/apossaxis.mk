@@ -18,6 +18,7 @@ test-apossaxis: $(ST_LIB) $(STC)
 TESTS += test-apossaxis-tune
 STRESS_TESTS += test-apossaxis-tune
 .PHONY: test-apossaxis-tune
-test-apossaxis-tune: $(BUILD)/plc/aposs/plcrt
-	@mk/suite.sh $(RESULTS) apossaxis-tune python3 tests/apossaxis/test_tune.py \
+test-apossaxis-tune: $(BUILD)/plc/aposs/plcrt $(ST_LIB) $(STC)
+	@mk/suite.sh $(RESULTS) apossaxis-tune env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" \
+	    CFLAGS="$(CFLAGS)" ST_LIB="$(abspath $(ST_LIB))" python3 tests/apossaxis/test_tune.py \
 	    $(BUILD)/plc/aposs/plcrt examples/aposs/aposs.ini $(abspath $(BUILD))/tests/apossaxis-tune
