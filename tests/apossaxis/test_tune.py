@@ -268,18 +268,28 @@ def main():
         # the oscillation onset, by this test's own bisection
         for k, v in {"FFVEL": 875, "FFACC": 24, "KDER": 0, "KINT": 0, "BANDWIDTH": 1000, "POSERR": 1000000}.items():
             ax.set(k, v)
-        lo, hi = 400, 900
-        ok_bracket = not oscillates(ax, lo, work) and oscillates(ax, hi, work)
-        while ok_bracket and hi - lo > 0.01 * hi:
-            mid = (lo + hi) // 2
-            if oscillates(ax, mid, work):
-                hi = mid
-            else:
-                lo = mid
+        # near the onset the axis chatters by a count at standstill, and
+        # where within a count a run starts can make one bisection find the
+        # onset early: two bisections, the higher onset (the lower is the
+        # chatter's, not the loop's)
+        onsets = []
+        for _ in range(2):
+            lo, hi = 400, 900
+            ok_bracket = not oscillates(ax, lo, work) and oscillates(ax, hi, work)
+            while ok_bracket and hi - lo > 0.01 * hi:
+                mid = (lo + hi) // 2
+                if oscillates(ax, mid, work):
+                    hi = mid
+                else:
+                    lo = mid
+            if not ok_bracket:
+                break
+            onsets.append(hi)
+        hi = max(onsets) if onsets else hi
         ax.set("POSERR", 20000)
         kp = g.get("KPROP", -1)
         print(f"the loop's linear stability limit from the plant's data: KPROP {linear_onset(ini):.0f}", flush=True)
-        print(f"oscillation onset measured by the test: KPROP {hi} (steady at {lo}); the tool's {g.get('KPROP_OSC')}",
+        print(f"oscillation onset measured by the test: KPROP {hi} (bisections: {onsets}); the tool's {g.get('KPROP_OSC')}",
               flush=True)
         report("apossaxis/tune: KPROP within 10 % of 70 % of the oscillation onset this test measured",
                ok_bracket and abs(kp - 0.7 * hi) <= 0.1 * 0.7 * hi,
