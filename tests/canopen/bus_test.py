@@ -100,9 +100,11 @@ limit = 2 * HB_CONS + rt
 t_stop_wall = time.time()   # the bus's clock, for the recorded frames
 t_lost = m.wait("node 3: heartbeat lost", limit + patience, since=t_stop)
 ok = wait_for(lambda: s3.get(0x6200, 1) == 0 and s3.get(0x6411, 2) == 0, limit + patience)
-report("hb_lost_detected", t_lost is not None and t_lost - t_stop <= limit,
-       (f"{(t_lost - t_stop) * 1000:.0f} ms after the stop" if t_lost else "not detected")
-       + f", limit {limit * 1000:.0f} ms")
+# when is judged on the bus below (hb_lost_outputs_safe, from candump's
+# kernel timestamps); the test's own clock only says that it was reported
+report("hb_lost_detected", t_lost is not None,
+       (f"reported {(t_lost - t_stop) * 1000:.0f} ms after the stop" if t_lost else "not reported")
+       + f" (limit on the bus {limit * 1000:.0f} ms)")
 report("hb_lost_outputs_reach_slave", ok, "outputs 0 at the slave")
 s2.set(0x6000, 1, 0x42)
 report("other_node_keeps_exchanging", wait_for(lambda: s2.get(0x6200, 1) == 0x42, patience))
@@ -110,7 +112,9 @@ report("other_node_keeps_exchanging", wait_for(lambda: s2.get(0x6200, 1) == 0x42
 # 6. node 3 resets (power cycle): reconfigured, started, exchanging again
 t_reset = time.monotonic()
 s3.boot()
-ok = m.wait("node 3: configured", 3 + patience, since=t_reset) is not None
+# a loaded host may make the first configuration's SDO time out: the
+# master then retries after its retry interval (5 s); wait for the result
+ok = m.wait("node 3: configured", 30 + patience, since=t_reset) is not None
 s3.set(0x6000, 1, 0x77)
 ok = ok and wait_for(lambda: s3.state == 5 and s3.get(0x6200, 1) == 0x77, patience)
 report("reset_node_reconfigured", ok and s3.get(0x1601, 1) == 0x64110110 and s3.get(0x1017) == 100,
