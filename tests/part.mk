@@ -43,3 +43,5 @@ include tests/xmlexport/xmlexport.mk
 include tests/cam/cam.mk
 # ---- docs/getting-started.md, run as the page says ----
 include tests/getting_started/getting_started.mk
+
+include tests/editor_export/editor_export.mk
