@@ -18,14 +18,11 @@ int stc_compile_lib(const Source *srcs, int nsrcs, int nlib, const char *outdir)
     if (setjmp(jb)) { stc_error_jmp = NULL; xfree_all(); return 1; }
     Unit u = {0};
     parse_unit(&u, &lib, true);
+    /* a file with nothing in it (comments only, or empty) is accepted, as
+    ** matiec does */
     for (int i = 0; i < nsrcs; i++) {
-        int npous = u.pous.n, ntypes = u.types.n, nconfigs = u.configs.n;
         u.library = i < nlib;
         parse_unit(&u, &srcs[i], false);
-        if (u.pous.n == npous && u.types.n == ntypes && u.configs.n == nconfigs) {
-            Loc at = {&srcs[i], 1, 1};
-            fatal_at(at, "nothing to compile: no FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
-        }
     }
     u.library = false;
     replace_library(&u);

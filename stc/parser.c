@@ -923,8 +923,17 @@ static void configuration(P *p) {
     c->loc = n->loc;
     while (is_kw(cur(p), "VAR_GLOBAL")) var_block(p, &c->globals, true);
     if (!is_kw(cur(p), "RESOURCE")) {
-        if (is_kw(cur(p), "TASK") || is_kw(cur(p), "PROGRAM"))
-            fatal_at(cur(p)->loc, "a configuration needs a RESOURCE ... ON PLC around its tasks and programs");
+        if (is_kw(cur(p), "TASK") || is_kw(cur(p), "PROGRAM")) {
+            /* IEC 61131-3's single resource: tasks and program instances
+            ** right in the configuration. As matiec: one resource named
+            ** RESOURCE in C, none in the variables' paths (CONFIG.INST.X). */
+            Resource *r = xalloc(sizeof *r);
+            r->name = r->uname = "RESOURCE";
+            r->loc = cur(p)->loc;
+            r->single = true;
+            resource_body(p, r);
+            vec_push(&c->resources, r);
+        }
         expect_end(p, t, "CONFIGURATION", "END_CONFIGURATION");
         vec_push(&p->u->configs, c);
         return;

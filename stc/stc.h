@@ -203,6 +203,7 @@ typedef struct Resource {
     Vec tasks;     /* Task */
     Vec progs;     /* ProgInst */
     Vec gsyms;
+    bool single;   /* tasks and programs right in the CONFIGURATION (no RESOURCE) */
 } Resource;
 
 typedef struct Config {

@@ -51,7 +51,7 @@ export = open(os.path.join(here, "project", "generated_plc.st")).read()
 ini = open(os.path.join(here, "project", "plcrt.ini")).read()
 
 
-def move_axis(exe, proj, what):
+def move_axis(exe, proj, what, ini=ini):
     """plcrt moves the simulated axis to 3000 Um when target and go are
     written (docs/getting-started.md's symbols); the plant's own position
     (input registers 1088-1089, docs/modbus.md) says where it went."""
@@ -170,7 +170,19 @@ r2 = subprocess.run([os.path.join(tree, "build", "stc", "stc"), "-T", os.path.jo
                     capture_output=True, text=True)
 report("the joined file compiles on its own", r2.returncode == 0, r2.stderr[-500:])
 
-# 5. upstream iec2c on the same (make test-matiec)
+# 5. a configuration without RESOURCE (IEC 61131-3's single resource, as
+# matiec takes it): the variables are CONFIG0.AXIS.*, and plcrt finds them
+single = dict(files, **{"config.st": "CONFIGURATION Config0\n  TASK main(INTERVAL := T#2ms, PRIORITY := 0);\n"
+                                     "  PROGRAM axis WITH main : OneAxis;\nEND_CONFIGURATION\n",
+                        "plcrt.ini": ini.replace("CONFIG0.RES0.", "CONFIG0.")})
+proj = project("single", single)
+rc, out = build(proj)
+report("a configuration without RESOURCE builds; plcrt.ini's CONFIG0.AXIS.* symbols are found",
+       rc == 0 and "configuration OK (backend sim, 6 Modbus symbols)" in out, out[-800:])
+if rc == 0:
+    move_axis(os.path.join(proj, "build", "plcrt"), proj, "single resource", single["plcrt.ini"])
+
+# 6. upstream iec2c on the same (make test-matiec)
 if matiec:
     proj = project("export-matiec", {"generated_plc.st": export, "plcrt.ini": ini})
     rc, out = build(proj, "matiec")
