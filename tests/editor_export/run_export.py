@@ -182,7 +182,23 @@ report("a configuration without RESOURCE builds; plcrt.ini's CONFIG0.AXIS.* symb
 if rc == 0:
     move_axis(os.path.join(proj, "build", "plcrt"), proj, "single resource", single["plcrt.ini"])
 
-# 6. upstream iec2c on the same (make test-matiec)
+# 6. a located variable the image cannot hold (an OpenPLC sample's
+# `tempSensor1 AT %IW0.0 : UINT;`): the user's line and what to write
+proj = project("located", {
+    "hello.st": "PROGRAM Hello\n  VAR\n    tempSensor1 AT %IW0.0 : UINT;\n    far AT %QW2000 : INT;\n"
+                "    ok AT %IX0.3 : BOOL;\n  END_VAR\n  far := 1;\nEND_PROGRAM\n"
+                "CONFIGURATION Config0\n  RESOURCE Res0 ON PLC\n    TASK t(INTERVAL := T#10ms, PRIORITY := 0);\n"
+                "    PROGRAM h WITH t : Hello;\n  END_RESOURCE\nEND_CONFIGURATION\n",
+    "plcrt.ini": "[io]\nbackend = none\n"})
+rc, out = build(proj)
+report("%IW0.0: an error at the user's line saying to write %IW0",
+       rc == 1 and "located/hello.st:3:20: error: %IW0.0 is not in plcrt's process image: write %IW0 " in out
+       and "static assert" not in out, out[-800:])
+report("%QW2000: an error at the user's line giving the image's range",
+       "located/hello.st:4:12: error: %QW2000 is not in plcrt's process image: use an address from %QW0 to %QW1023" in out,
+       out[-800:])
+
+# 7. upstream iec2c on the same (make test-matiec)
 if matiec:
     proj = project("export-matiec", {"generated_plc.st": export, "plcrt.ini": ini})
     rc, out = build(proj, "matiec")
