@@ -54,7 +54,7 @@ deps:
 
 # Every suite runs even when one fails; the summary decides the exit status.
 test:
-	@mk/deps.sh
+	@mk/deps.sh all
 	@$(MAKE) --no-print-directory all
 	@rm -rf $(RESULTS) && mkdir -p $(RESULTS)
 	@$(MAKE) --no-print-directory -k $(TESTS) || touch $(RESULTS)/.make-failed
@@ -70,11 +70,14 @@ test-matiec:
 	  RESULTS=build-matiec/results $(MATIEC_TESTS) || touch build-matiec/results/.make-failed
 	@mk/summary.sh build-matiec/results
 
-# make run PROJECT=dir: build and run a project outside the tree (plcrt-build)
+# make run: only what the runtime and the demo need (mk/deps.sh run), built
+# on every core; make run PROJECT=dir: build and run a project outside the
+# tree (plcrt-build)
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 run:
-	@mk/deps.sh
+	@mk/deps.sh run
 ifeq ($(PROJECT),)
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory -j$(JOBS) $(RUN_DEMO_BIN)
 	@$(MAKE) --no-print-directory $(RUN_DEMO)
 else
 	@./plcrt-build --run $(PROJECT)

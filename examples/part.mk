@@ -21,3 +21,4 @@ ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 $(EXAMPLES:%=run-%): run-%: $(BUILD)/plc/%/plcrt
 	@mk/run_fg.sh $(BUILD)/plc/$*/plcrt -c $(or $(INI),examples/$*/$*.ini)
 RUN_DEMO := run-epicpos
+RUN_DEMO_BIN := $(BUILD)/plc/epicpos/plcrt

@@ -45,3 +45,5 @@ include tests/cam/cam.mk
 include tests/getting_started/getting_started.mk
 
 include tests/editor_export/editor_export.mk
+
+include tests/deps/deps.mk
