@@ -14,7 +14,7 @@ fail() { echo "FAIL: deps/$1: $2"; st=1; }
 
 # the README's list of runtime packages: the line after "Debian packages of `make run`"
 readme=$(sed -n '/^Debian packages of `make run`/,+2p' README.md | tr -s ' \n' ' ')
-want=$(printf '%s\n' gcc make pkg-config libinih-dev libmodbus-dev python3 python3-matplotlib | sort | tr '\n' ' ')
+want=$(printf '%s\n' gcc make pkg-config libinih-dev libmodbus-dev python3 python3-matplotlib python3-pip | sort | tr '\n' ' ')
 got=$(mk/deps.sh --list run | sed -n 's/^debian: //p' | tr ' ' '\n' | sort | tr '\n' ' ')
 [ "$got" = "$want" ] && pass "make run installs the runtime's packages only" || fail "make run's packages" "got '$got', want '$want'"
 miss=
