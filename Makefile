@@ -40,12 +40,13 @@ BENCHES :=
 FUZZES  :=
 RUN_DEMO :=
 
-.PHONY: all deps test run bench fuzz clean check-results test-matiec
+.PHONY: all deps test run bench fuzz clean check-results test-matiec install deb
 all:
 
 include $(wildcard stc/part.mk) $(wildcard c_blocks/part.mk) $(wildcard st/part.mk)
 include $(wildcard plc_runtime/part.mk) $(wildcard tests/part.mk)
 include $(wildcard examples/part.mk) $(wildcard bench/part.mk)
+include mk/install.mk
 
 all: $(ALL)
 

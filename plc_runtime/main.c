@@ -25,6 +25,7 @@
 #include "program.h"
 #include "retain.h"
 #include "scan.h"
+#include "sdnotify.h"
 #include "trace.h"
 #include "tracemb.h"
 
@@ -446,6 +447,8 @@ int main(int argc, char **argv)
             rt_ok ? "SCHED_FIFO" : "normal priority", cfg.backend);
 
     /* housekeeping */
+    sdnotify notify;   /* the service manager: ready, alive (sdnotify.h) */
+    sdnotify_open(&notify);
     uint64_t t_status = scan_now_ns(), t_retain = t_status, t_over = t_status;
     uint64_t last_over = 0;
     int stop_sig = SIGTERM;
@@ -470,6 +473,7 @@ int main(int argc, char **argv)
         }
         if (sig == SIGUSR1) stats_print(stderr, &sc.stats, period);
         uint64_t now = scan_now_ns();
+        sdnotify_tick(&notify, now, atomic_load(&sc.stats.cycles));
         stat_summary es, ls;
         stat_summarize(&sc.stats.exec, &es);
         stat_summarize(&sc.stats.lat, &ls);
@@ -509,6 +513,7 @@ int main(int argc, char **argv)
         }
     }
 
+    sdnotify_close(&notify);
     shut_down(&sc, th, srv, mb, &cfg, &ret, stop_sig);
     tb_free(tb);
     force_free(fo);

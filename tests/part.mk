@@ -47,3 +47,5 @@ include tests/getting_started/getting_started.mk
 include tests/editor_export/editor_export.mk
 
 include tests/deps/deps.mk
+
+include tests/install/install.mk
