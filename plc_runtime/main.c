@@ -26,6 +26,7 @@
 #include "retain.h"
 #include "scan.h"
 #include "sdnotify.h"
+#include "tags.h"
 #include "trace.h"
 #include "tracemb.h"
 
@@ -38,6 +39,7 @@ static void usage(FILE *f)
         "Runs the linked PLC program (configuration %s) every %.3f ms.\n"
         "  -c, --config FILE   configuration file (docs/config.md); defaults otherwise\n"
         "      --check-config  check the configuration (file, program, this host) and exit\n"
+        "      --tags DIR      check it, write the tag list (TAGS.csv, TAGS.json: tags.h) into DIR, exit\n"
         "  -h, --help          this text\n"
         "  -V, --version       version and linked program\n"
         "Signals: SIGINT/SIGTERM/SIGHUP/SIGQUIT stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",
@@ -279,15 +281,17 @@ int main(int argc, char **argv)
 {
     static const struct option opts[] = {
         { "config", required_argument, 0, 'c' }, { "check-config", no_argument, 0, 'k' },
-        { "help", no_argument, 0, 'h' }, { "version", no_argument, 0, 'V' }, { 0, 0, 0, 0 }
+        { "help", no_argument, 0, 'h' }, { "version", no_argument, 0, 'V' },
+        { "tags", required_argument, 0, 't' }, { 0, 0, 0, 0 }
     };
-    const char *file = NULL;
+    const char *file = NULL, *tags = NULL;
     int check = 0, o;
     char err[600];
     while ((o = getopt_long(argc, argv, "c:hV", opts, NULL)) != -1) {
         switch (o) {
         case 'c': file = optarg; break;
         case 'k': check = 1; break;
+        case 't': tags = optarg; check = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': printf("plcrt %s (program %s, %.3f ms)\n", PLCRT_VERSION, plc_program_linked.name,
                          *plc_program_linked.ticktime / 1e6); return 0;
@@ -308,6 +312,10 @@ int main(int argc, char **argv)
     int st = configure(&cfg, file, prog, status, &mb);
     if (st) return st;
     uint64_t period = *prog->ticktime;
+    if (tags && tags_write(prog, mb, tags, err, sizeof err)) {
+        fprintf(stderr, "plcrt: tag list: %s\n", err);
+        return 2;
+    }
     if (check) {
         printf("%s: configuration OK (backend %s, %d Modbus symbols)\n",
                file ? file : "(defaults)", cfg.backend, cfg.nsymbols);

@@ -6,7 +6,7 @@ PLCRT_B    := $(BUILD)/plc_runtime
 PLCRT_CFLAGS := $(CFLAGS) -I plc_runtime $(shell pkg-config --cflags libmodbus 2>/dev/null || echo -I/usr/include/modbus)
 PLCRT_LIBS := -linih -lmodbus -lpthread -lm
 PLCRT_CORE := plc_image log stats config program mbmap mbserver retain scan \
-              trace force tracemb sdnotify \
+              trace force tracemb sdnotify tags \
               io_none io_sim io_backends
 PLCRT_OBJ  := $(PLCRT_CORE:%=$(PLCRT_B)/%.o) $(C_BLOCKS_OBJ)
 include $(wildcard plc_runtime/canopen/part.mk)

@@ -49,3 +49,5 @@ include tests/editor_export/editor_export.mk
 include tests/deps/deps.mk
 
 include tests/install/install.mk
+
+include tests/tags/tags.mk
