@@ -51,3 +51,5 @@ include tests/deps/deps.mk
 include tests/install/install.mk
 
 include tests/tags/tags.mk
+
+include tests/readme/readme.mk
