@@ -43,6 +43,11 @@ else
     fail "installed plcrt-build" "status $rc: $out"
 fi
 
+# the sample configuration fits that project (the simulated axis of getting-started)
+cp "$pfx/etc/plcrt/plcrt.ini" "$work/proj/sample.ini"
+out=$(cd "$work/proj" && myaxis/build/plcrt -c sample.ini --check-config 2>&1)
+[ $? -eq 0 ] && pass "the sample /etc configuration passes plcrt --check-config" || fail "sample plcrt.ini" "$out"
+
 dest=$work/dest
 if mk install PREFIX=/usr DESTDIR="$dest" && [ -x "$dest/usr/bin/stc" ] && [ -f "$dest/etc/plcrt/plcrt.ini" ] &&
    ! grep -rqs "$dest" "$dest/usr/lib/plcrt/parts.sh" "$dest/lib/systemd/system" "$dest/usr/lib/systemd/system"; then

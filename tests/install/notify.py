@@ -89,4 +89,56 @@ msgs, rc, out = run("otherpid", path, path, watchdog_pid=1, seconds=2.0)
 kinds = [m for _, m in msgs]
 report("WATCHDOG_PID of another process: READY=1, no pings",
        any(k.startswith("READY=1") for k in kinds) and "WATCHDOG=1" not in kinds, str(kinds))
+# a stalled scan: the program sleeps 3 s in one cycle when coil 0 is set (its
+# own watchdog off); the pings stop for that time, then resume
+tree = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+proj = os.path.join(work, "stall")
+os.makedirs(proj, exist_ok=True)
+with open(os.path.join(proj, "stall.st"), "w") as f:
+    f.write("PROGRAM Stall\n  VAR stall AT %QX0.0 : BOOL; END_VAR\n"
+            "  IF stall THEN\n    stall := FALSE;\n"
+            "    {{ { struct timespec ts = { 3, 0 }; nanosleep(&ts, NULL); } }}\n  END_IF;\nEND_PROGRAM\n"
+            "CONFIGURATION C\n  RESOURCE R ON PLC\n    TASK t(INTERVAL := T#10ms, PRIORITY := 0);\n"
+            "    PROGRAM s WITH t : Stall;\n  END_RESOURCE\nEND_CONFIGURATION\n")
+sport = free_port()
+with open(os.path.join(proj, "plcrt.ini"), "w") as f:
+    f.write("[scan]\nwatchdog_ms = 0\n\n[io]\nbackend = none\n\n[modbus]\nport = %d\n" % sport)
+env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
+b = subprocess.run([os.path.join(tree, "plcrt-build"), proj], env=env, capture_output=True, text=True)
+report("the stalling program builds", b.returncode == 0, b.stdout + b.stderr)
+if b.returncode == 0:
+    from pymodbus.client import ModbusTcpClient
+    sock = os.path.join(work, "stall.sock")
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+    s.bind(sock)
+    s.settimeout(0.2)
+    env = dict(os.environ, NOTIFY_SOCKET=sock, WATCHDOG_USEC=str(WD_US))
+    log = open(os.path.join(work, "stall.log"), "w")
+    p = subprocess.Popen([os.path.join(proj, "build", "plcrt"), "-c", "plcrt.ini"], cwd=proj, env=env,
+                         stdout=log, stderr=log)
+    msgs, t_stall = [], None
+    end = time.monotonic() + 40
+    c = ModbusTcpClient("127.0.0.1", port=sport)
+    while time.monotonic() < end:
+        try:
+            msgs.append((time.monotonic(), s.recv(4096).decode()))
+        except socket.timeout:
+            pass
+        pings = [t for t, m in msgs if m == "WATCHDOG=1"]
+        if t_stall is None and len(pings) >= 2:
+            c.connect()
+            t_stall = time.monotonic()
+            c.write_coil(0, True, slave=1)
+        if t_stall and len([t for t in pings if t > t_stall + 3]) >= 2:
+            break
+    c.close()
+    p.send_signal(signal.SIGTERM)
+    p.wait(timeout=15)
+    s.close()
+    pings = [t for t, m in msgs if m == "WATCHDOG=1"]
+    during = [t - t_stall for t in pings if t_stall and t_stall + 0.3 < t < t_stall + 2.9]
+    after = [t for t in pings if t_stall and t > t_stall + 3]
+    report("a scan stalled 3 s: no WATCHDOG=1 while it stalls, pings again after",
+           t_stall is not None and not during and len(after) >= 2,
+           "pings during the stall at %s s, %d after" % (["%.2f" % x for x in during], len(after)))
 sys.exit(0 if report.all_passed() else 1)
