@@ -208,7 +208,11 @@ int stc_join_files(const Source *srcs, int nsrcs, int nlib, const char *out, con
         int *seen = xalloc(sizeof *seen * (size_t)(n + 1));
         for (int i = 0; i < n; i++)
             for (const Token *t = items[i]->first; t <= items[i]->last; t++) {
-                Item *d = t->kind == TK_IDENT ? lookup(&decl, t->up) : NULL;
+                /* not a name being declared (`x, y : T`) nor a member (`a.x`) */
+                if (t->kind != TK_IDENT || (t < items[i]->last && (is_punct(t + 1, ":") || is_punct(t + 1, ","))) ||
+                    (t > items[i]->first && is_punct(t - 1, ".")))
+                    continue;
+                Item *d = lookup(&decl, t->up);
                 if (!d || d == items[i] || seen[d->index] == i + 1) continue;
                 seen[d->index] = i + 1;
                 vec_push(&needs[i], d);
