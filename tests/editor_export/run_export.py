@@ -170,6 +170,17 @@ r2 = subprocess.run([os.path.join(tree, "build", "stc", "stc"), "-T", os.path.jo
                     capture_output=True, text=True)
 report("the joined file compiles on its own", r2.returncode == 0, r2.stderr[-500:])
 
+# a variable named like a block is no use of it: Outer holds an Inner, and
+# Inner's input is called Outer; Inner must still come first
+src = os.path.join(work, "names.st")
+with open(src, "w") as f:
+    f.write("FUNCTION_BLOCK Outer\n  VAR i : Inner; END_VAR\n  i(Outer := 1);\nEND_FUNCTION_BLOCK\n"
+            "FUNCTION_BLOCK Inner\n  VAR_INPUT Outer : INT; END_VAR\nEND_FUNCTION_BLOCK\n")
+r = subprocess.run([os.path.join(tree, "build", "stc", "stc"), "--join", src + ".out", src], capture_output=True, text=True)
+out = open(src + ".out").read() if r.returncode == 0 else ""
+report("stc --join: a variable named like a block does not order it",
+       0 <= out.find("FUNCTION_BLOCK Inner") < out.find("FUNCTION_BLOCK Outer"), out + r.stderr)
+
 # 5. a configuration without RESOURCE (IEC 61131-3's single resource, as
 # matiec takes it): the variables are CONFIG0.AXIS.*, and plcrt finds them
 single = dict(files, **{"config.st": "CONFIGURATION Config0\n  TASK main(INTERVAL := T#2ms, PRIORITY := 0);\n"
