@@ -94,6 +94,10 @@ int main(int argc, char **argv) {
     memcpy(all, libs, sizeof *all * (size_t)nlib);
     memcpy(all + nlib, inputs, sizeof *all * (size_t)ninputs);
     for (int i = 0; i < nlib + ninputs; i++) all[i].text = read_file(all[i].name, &all[i].len);
-    if (join) return stc_join_files(all, nlib + ninputs, nlib, join, map);
-    return stc_compile_lib(all, nlib + ninputs, nlib, outdir);
+    int rc = join ? stc_join_files(all, nlib + ninputs, nlib, join, map)
+                  : stc_compile_lib(all, nlib + ninputs, nlib, outdir);
+    free(all);
+    free(libs);
+    free(inputs);
+    return rc;
 }
