@@ -41,12 +41,13 @@ BENCHES :=
 FUZZES  :=
 RUN_DEMO :=
 
-.PHONY: all deps test run bench fuzz clean check-results test-matiec test-stress
+.PHONY: all deps test run bench fuzz clean check-results test-matiec test-stress install deb
 all:
 
 include $(wildcard stc/part.mk) $(wildcard c_blocks/part.mk) $(wildcard st/part.mk)
 include $(wildcard plc_runtime/part.mk) $(wildcard tests/part.mk)
 include $(wildcard examples/part.mk) $(wildcard bench/part.mk)
+include mk/install.mk
 
 all: $(ALL)
 
@@ -55,7 +56,7 @@ deps:
 
 # Every suite runs even when one fails; the summary decides the exit status.
 test:
-	@mk/deps.sh
+	@mk/deps.sh all
 	@$(MAKE) --no-print-directory all
 	@rm -rf $(RESULTS) && mkdir -p $(RESULTS)
 	@$(MAKE) --no-print-directory -k $(TESTS) || touch $(RESULTS)/.make-failed
@@ -82,11 +83,14 @@ test-matiec:
 	  RESULTS=build-matiec/results $(MATIEC_TESTS) || touch build-matiec/results/.make-failed
 	@mk/summary.sh build-matiec/results
 
-# make run PROJECT=dir: build and run a project outside the tree (plcrt-build)
+# make run: only what the runtime and the demo need (mk/deps.sh run), built
+# on every core; make run PROJECT=dir: build and run a project outside the
+# tree (plcrt-build)
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 run:
-	@mk/deps.sh
+	@mk/deps.sh run
 ifeq ($(PROJECT),)
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory -j$(JOBS) $(RUN_DEMO_BIN)
 	@$(MAKE) --no-print-directory $(RUN_DEMO) RUN_WEB=mk/run_web.sh
 else
 	@./plcrt-build --run $(PROJECT)

@@ -27,3 +27,4 @@ ALL += $(BUILD)/plc/remoteio/plcrt
 .PHONY: run-remoteio
 run-remoteio: $(BUILD)/plc/remoteio/plcrt
 	@examples/remoteio/run.sh $(BUILD)/plc/remoteio/plcrt $(INI)
+RUN_DEMO_BIN := $(BUILD)/plc/epicpos/plcrt

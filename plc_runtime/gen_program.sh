@@ -8,6 +8,8 @@
 # matiec's resource file defines each program instance's name as a macro
 # (`#define P RES0__P`); past the resource files those are undefined, so a
 # variable or member of the same name (`p`, `axis`) means itself again.
+# A configuration without RESOURCE (tasks and programs right in it) has
+# instance paths CONFIG.INST and C names RESOURCE__INST, as matiec writes.
 set -eu
 dir=$1 out=$2
 csv=$dir/VARIABLES.csv
@@ -50,13 +52,14 @@ BEGIN {
 /^\/\/ Programs/ { sec = "p"; next }
 /^\/\/ Variables/ { sec = "v"; next }
 /^\/\// { sec = ""; next }
-sec == "p" && NF > 2 { split($2, a, "."); res[a[2]] = 1; next }
+sec == "p" && NF > 2 { if (split($2, a, ".") == 2) single[a[2]] = 1; else res[a[2]] = 1; next }
 sec == "v" && NF > 6 {
     kind = $2; path = $3; c = $4; type = $5; ret = $7
     if (kind == "FB" || kind == "EXT") next
     k = split(c, a, ".")
     if (k < 2) next
     if (k >= 3 && (a[2] in res)) { cp = a[2] "__" a[3]; s = 4 }
+    else if (a[2] in single) { cp = "RESOURCE__" a[2]; s = 3 }
     else { cp = cfg "__" a[2]; s = 3 }
     for (i = s; i <= k; i++) cp = cp "." a[i]
     if (type in elem)

@@ -26,6 +26,8 @@
 #include "program.h"
 #include "retain.h"
 #include "scan.h"
+#include "sdnotify.h"
+#include "tags.h"
 #include "trace.h"
 #include "tracemb.h"
 
@@ -38,6 +40,7 @@ static void usage(FILE *f)
         "Runs the linked PLC program (configuration %s) every %.3f ms.\n"
         "  -c, --config FILE   configuration file (docs/config.md); defaults otherwise\n"
         "      --check-config  check the configuration (file, program, this host) and exit\n"
+        "      --tags DIR      check it, write the tag list (TAGS.csv, TAGS.json: tags.h) into DIR, exit\n"
         "  -h, --help          this text\n"
         "  -V, --version       version and linked program\n"
         "Signals: SIGINT/SIGTERM/SIGHUP/SIGQUIT stop (outputs safe, retain saved), SIGUSR1 prints statistics.\n",
@@ -289,15 +292,17 @@ int main(int argc, char **argv)
 {
     static const struct option opts[] = {
         { "config", required_argument, 0, 'c' }, { "check-config", no_argument, 0, 'k' },
-        { "help", no_argument, 0, 'h' }, { "version", no_argument, 0, 'V' }, { 0, 0, 0, 0 }
+        { "help", no_argument, 0, 'h' }, { "version", no_argument, 0, 'V' },
+        { "tags", required_argument, 0, 't' }, { 0, 0, 0, 0 }
     };
-    const char *file = NULL;
+    const char *file = NULL, *tags = NULL;
     int check = 0, o;
     char err[600];
     while ((o = getopt_long(argc, argv, "c:hV", opts, NULL)) != -1) {
         switch (o) {
         case 'c': file = optarg; break;
         case 'k': check = 1; break;
+        case 't': tags = optarg; check = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': printf("plcrt %s (program %s, %.3f ms)\n", PLCRT_VERSION, plc_program_linked.name,
                          *plc_program_linked.ticktime / 1e6); return 0;
@@ -318,6 +323,10 @@ int main(int argc, char **argv)
     int st = configure(&cfg, file, prog, status, &mb);
     if (st) return st;
     uint64_t period = *prog->ticktime;
+    if (tags && tags_write(prog, mb, tags, err, sizeof err)) {
+        fprintf(stderr, "plcrt: tag list: %s\n", err);
+        return 2;
+    }
     if (check) {
         printf("%s: configuration OK (backend %s, %d Modbus symbols)\n",
                file ? file : "(defaults)", cfg.backend, cfg.nsymbols);
@@ -466,6 +475,8 @@ int main(int argc, char **argv)
             rt_ok ? "SCHED_FIFO" : "normal priority", cfg.backend);
 
     /* housekeeping */
+    sdnotify notify;   /* the service manager: ready, alive (sdnotify.h) */
+    sdnotify_open(&notify);
     uint64_t t_status = scan_now_ns(), t_retain = t_status, t_over = t_status;
     uint64_t last_over = 0;
     int stop_sig = SIGTERM;
@@ -490,6 +501,7 @@ int main(int argc, char **argv)
         }
         if (sig == SIGUSR1) stats_print(stderr, &sc.stats, period);
         uint64_t now = scan_now_ns();
+        sdnotify_tick(&notify, now, atomic_load(&sc.stats.cycles));
         stat_summary es, ls;
         stat_summarize(&sc.stats.exec, &es);
         stat_summarize(&sc.stats.lat, &ls);
@@ -529,6 +541,7 @@ int main(int argc, char **argv)
         }
     }
 
+    sdnotify_close(&notify);
     shut_down(&sc, th, srv, mb, &cfg, &ret, stop_sig);
     tb_free(tb);
     force_free(fo);

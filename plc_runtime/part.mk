@@ -6,7 +6,7 @@ PLCRT_B    := $(BUILD)/plc_runtime
 PLCRT_CFLAGS := $(CFLAGS) -I plc_runtime $(shell pkg-config --cflags libmodbus 2>/dev/null || echo -I/usr/include/modbus)
 PLCRT_LIBS := -linih -lmodbus -lpthread -lm
 PLCRT_CORE := plc_image log stats config program mbmap mbserver mbrtu retain scan \
-              trace force tracemb \
+              trace force tracemb sdnotify tags \
               io_none io_sim io_backends io_multi io_modbus
 PLCRT_OBJ  := $(PLCRT_CORE:%=$(PLCRT_B)/%.o) $(C_BLOCKS_OBJ)
 include $(wildcard plc_runtime/canopen/part.mk)
@@ -48,8 +48,8 @@ endef
 # plcrt-parts: what plcrt-build (a user's project outside the tree) needs
 # from here, built, and listed in $(BUILD)/plc_runtime/parts.sh for it.
 .PHONY: plcrt-parts
-plcrt-parts: $(STC) $(ST_LIB) $(PLCRT_MAIN) $(PLCRT_OBJ)
-	@{ echo "STC='$(abspath $(STC))'"; echo "STC_INC='$(abspath $(STC_INC))'"; \
+plcrt-parts: $(STC) $(STC_BIN) $(ST_LIB) $(PLCRT_MAIN) $(PLCRT_OBJ)
+	@{ echo "STC='$(abspath $(STC))'"; echo "STC_BIN='$(abspath $(STC_BIN))'"; echo "STC_INC='$(abspath $(STC_INC))'"; \
 	   echo "ST_LIB_SRC='$(abspath $(ST_LIB_SRC))'"; echo "GEN_PROGRAM='$(abspath plc_runtime/gen_program.sh)'"; \
 	   echo "RT_INC='$(abspath plc_runtime)'"; echo "CC='$(CC)'"; echo "CFLAGS='$(CFLAGS)'"; \
 	   echo "GEN_CFLAGS='$(PLC_GEN_CFLAGS)'"; \

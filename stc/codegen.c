@@ -1055,6 +1055,12 @@ static int64_t gcd64(int64_t a, int64_t b) { while (b) { int64_t t = a % b; a = 
 /* VARIABLES.csv rows: one per variable, an FB instance followed by its own. */
 static void csv_vars(Buf *b, int *num, Pou *p, const char *path, bool retain);
 
+/* a resource's variables' path prefix: CONFIG.RES, or CONFIG for the single
+** resource of a configuration without RESOURCE (as matiec writes it) */
+static const char *res_path(const Config *cf, const Resource *res) {
+    return res->single ? cf->uname : fmt("%s.%s", cf->uname, res->uname);
+}
+
 /* The elementary parts of an array or a structure, one row each: the IEC
 ** path with the indexes as written (TAB[2,3], CFG.LIMITS.MAX), the C path
 ** to the element (TAB.table[k]). Arrays of function blocks are left out;
@@ -1192,7 +1198,7 @@ int codegen(Unit *u, const char *outdir) {
             Resource *res = cf->resources.v[r];
             for (int i = 0; i < res->progs.n; i++) {
                 ProgInst *pi = res->progs.v[i];
-                buf_printf(&csv, "%d;%s.%s.%s;%s;\n", num++, cf->uname, res->uname, pi->uname, pi->p ? pi->p->uname : "?");
+                buf_printf(&csv, "%d;%s.%s;%s;\n", num++, res_path(cf, res), pi->uname, pi->p ? pi->p->uname : "?");
             }
         }
     }
@@ -1233,7 +1239,7 @@ int codegen(Unit *u, const char *outdir) {
             Buf rinit = {0};
             for (int i = 0; i < res->gsyms.n; i++) {
                 Sym *s = res->gsyms.v[i];
-                csv_var(&csv, &num, s, fmt("%s.%s.%s", cf->uname, res->uname, s->uname), s->retain);
+                csv_var(&csv, &num, s, fmt("%s.%s", res_path(cf, res), s->uname), s->retain);
             }
             globals_code(&rc, &res->gsyms);
             globals_init(&g, &rinit, &res->gsyms);
@@ -1242,7 +1248,7 @@ int codegen(Unit *u, const char *outdir) {
                 if (!pi->p) continue;
                 buf_printf(&rc, "%s %s__%s;\n", pi->p->type->cname, res->uname, pi->uname);
                 buf_printf(&rinit, "  %s_init__(&%s__%s, retain);\n", pi->p->type->cname, res->uname, pi->uname);
-                char *vp = fmt("%s.%s.%s", cf->uname, res->uname, pi->uname);
+                char *vp = fmt("%s.%s", res_path(cf, res), pi->uname);
                 buf_printf(&csv, "%d;FB;%s;%s;%s;;%d;\n", num++, vp, vp, pi->p->type->cname, pi->retain);
                 csv_vars(&csv, &num, pi->p, vp, pi->retain);
             }

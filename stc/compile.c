@@ -9,7 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-int stc_compile_files(const Source *srcs, int nsrcs, const char *outdir) {
+int stc_compile_lib(const Source *srcs, int nsrcs, int nlib, const char *outdir) {
     static Source lib = {"<standard library>", stdlib_st, 0};
     lib.len = strlen(stdlib_st);
     jmp_buf jb;
@@ -18,14 +18,14 @@ int stc_compile_files(const Source *srcs, int nsrcs, const char *outdir) {
     if (setjmp(jb)) { stc_error_jmp = NULL; xfree_all(); return 1; }
     Unit u = {0};
     parse_unit(&u, &lib, true);
+    /* a file with nothing in it (comments only, or empty) is accepted, as
+    ** matiec does */
     for (int i = 0; i < nsrcs; i++) {
-        int npous = u.pous.n, ntypes = u.types.n, nconfigs = u.configs.n;
+        u.library = i < nlib;
         parse_unit(&u, &srcs[i], false);
-        if (u.pous.n == npous && u.types.n == ntypes && u.configs.n == nconfigs) {
-            Loc at = {&srcs[i], 1, 1};
-            fatal_at(at, "nothing to compile: no FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE or CONFIGURATION");
-        }
     }
+    u.library = false;
+    replace_library(&u);
     sema(&u);
     int rc = 1;
     if (!error_count) {
@@ -38,6 +38,10 @@ int stc_compile_files(const Source *srcs, int nsrcs, const char *outdir) {
     stc_error_jmp = NULL;
     xfree_all();
     return rc;
+}
+
+int stc_compile_files(const Source *srcs, int nsrcs, const char *outdir) {
+    return stc_compile_lib(srcs, nsrcs, 0, outdir);
 }
 
 int stc_compile(const Source *src, const char *outdir) {

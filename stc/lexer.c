@@ -58,6 +58,8 @@ static Token *add(Lexer *L, TokKind k, const char *s, const char *e) {
     t->loc = here(L, s);
     t->text = xstrndup(s, (size_t)(e - s));
     t->up = upcase(t->text);
+    t->pos = (size_t)(s - L->src->text);
+    t->end = (size_t)(e - L->src->text);
     vec_push(&L->toks, t);
     return t;
 }
@@ -381,6 +383,7 @@ Token *lex(const Source *src, int *count) {
             if (twin) {
                 Token *t = add(&L, TK_PRAGMA, p, p + 2);
                 t->sval = xstrndup(p + 2, (size_t)(e - p - 2));
+                t->end = (size_t)(e + 2 - src->text);
                 advance_to(&L, e + 2);
                 continue;
             }
@@ -392,6 +395,7 @@ Token *lex(const Source *src, int *count) {
                 Token *t = add(&L, TK_PRAGMA, p, p + 1);
                 t->sval = text;
                 t->ival = 1;
+                t->end = (size_t)(e + 1 - src->text);
                 if (!warned_single) {
                     warning_at(t->loc, "'{ ... }' pragma copied into the generated C, as matiec does: its text must be C for the target");
                     warned_single = true;

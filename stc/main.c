@@ -1,5 +1,7 @@
-/* stc command line: stc [-I libdir] [-T outdir] file.st..., like matiec's iec2c
-** (which takes one file; several make one program, as if concatenated). */
+/* stc command line: stc [-I libdir] [-T outdir] [-L lib.st]... file.st...,
+** like matiec's iec2c (which takes one file; several make one program, as if
+** concatenated); -L names the project's library, which the files' own
+** declarations replace; --join writes one file in declaration order. */
 #include "stc.h"
 
 #include <errno.h>
@@ -12,7 +14,8 @@
 #endif
 
 static void usage(FILE *f) {
-    fputs("usage: stc [-I libdir] [-T outdir] file.st...\n"
+    fputs("usage: stc [-I libdir] [-T outdir] [-L lib.st]... file.st...\n"
+          "       stc --join out.st [--map out.map] [-L lib.st]... file.st...\n"
           "       stc --version | --include-dir | --help\n"
           "Compiles IEC 61131-3 Structured Text to C, in matiec's file layout:\n"
           "POUS.c, POUS.h, <Config>.c/.h, <Resource>.c, LOCATED_VARIABLES.h and\n"
@@ -21,7 +24,14 @@ static void usage(FILE *f) {
           "declares, the others use.\n"
           "Build the output with: cc -I \"$(stc --include-dir)\" -c <Config>.c <Resource>.c\n"
           "  -I libdir  accepted for iec2c compatibility; the standard library is built in\n"
-          "  -T outdir  where to write the C files (created if missing)\n", f);
+          "  -T outdir  where to write the C files (created if missing)\n"
+          "  -L lib.st  a file of the project's library: a FUNCTION, FUNCTION_BLOCK,\n"
+          "             PROGRAM or type that file.st declares too replaces the library's\n"
+          "             (a warning when the two differ)\n"
+          "  --join out.st  compile nothing: write the declarations of the files as one\n"
+          "             file in which each comes before its first use (for iec2c, which\n"
+          "             reads one file in order); --map: which lines came from where,\n"
+          "             one \"FIRST LAST FROM FILE\" line per declaration\n", f);
 }
 
 static char *read_file(const char *path, size_t *len) {
@@ -47,15 +57,24 @@ static char *read_file(const char *path, size_t *len) {
 }
 
 int main(int argc, char **argv) {
-    const char *outdir = ".";
-    int ninputs = 0;
+    const char *outdir = ".", *join = NULL, *map = NULL;
+    int ninputs = 0, nlib = 0;
     Source *inputs = calloc((size_t)argc, sizeof *inputs);
-    if (!inputs) { fputs("stc: out of memory\n", stderr); return 1; }
+    Source *libs = calloc((size_t)argc, sizeof *libs);
+    if (!inputs || !libs) { fputs("stc: out of memory\n", stderr); return 1; }
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--version")) { printf("stc %s\n", STC_VERSION); return 0; }
         if (!strcmp(a, "--include-dir")) { printf("%s\n", STC_INCLUDE_DIR); return 0; }
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
+        if (!strcmp(a, "-L") || !strcmp(a, "--join") || !strcmp(a, "--map")) {
+            if (i + 1 >= argc) { fprintf(stderr, "stc: %s needs a file\n", a); return 1; }
+            if (a[1] == 'L') libs[nlib++].name = argv[i + 1];
+            else if (a[2] == 'j') join = argv[i + 1];
+            else map = argv[i + 1];
+            i++;
+            continue;
+        }
         if (!strcmp(a, "-T") || !strcmp(a, "-I")) {
             if (i + 1 >= argc) { fprintf(stderr, "stc: %s needs a folder\n", a); return 1; }
             if (a[1] == 'T') outdir = argv[i + 1];
@@ -69,6 +88,16 @@ int main(int argc, char **argv) {
     }
     if (!ninputs) { usage(stderr); return 1; }
 
-    for (int i = 0; i < ninputs; i++) inputs[i].text = read_file(inputs[i].name, &inputs[i].len);
-    return stc_compile_files(inputs, ninputs, outdir);
+    /* one list: the library's files first */
+    Source *all = calloc((size_t)(nlib + ninputs), sizeof *all);
+    if (!all) { fputs("stc: out of memory\n", stderr); return 1; }
+    memcpy(all, libs, sizeof *all * (size_t)nlib);
+    memcpy(all + nlib, inputs, sizeof *all * (size_t)ninputs);
+    for (int i = 0; i < nlib + ninputs; i++) all[i].text = read_file(all[i].name, &all[i].len);
+    int rc = join ? stc_join_files(all, nlib + ninputs, nlib, join, map)
+                  : stc_compile_lib(all, nlib + ninputs, nlib, outdir);
+    free(all);
+    free(libs);
+    free(inputs);
+    return rc;
 }

@@ -817,9 +817,23 @@ static void pou(P *p) {
     vec_push(&p->u->pous, u);
 }
 
+/* the top-level declaration whose tokens are first..the one before cur */
+static Item *add_item(P *p, ItemKind kind, void *decl, const char *uname, int first) {
+    Item *it = xalloc(sizeof *it);
+    it->kind = kind;
+    it->decl = decl;
+    it->uname = uname;
+    it->first = &p->t[first];
+    it->last = &p->t[p->i - 1];
+    it->library = p->u->library;
+    vec_push(&p->u->items, it);
+    return it;
+}
+
 static void type_block(P *p) {
     Token *t = next(p);
     while (cur(p)->kind == TK_IDENT && !is_reserved(cur(p)->up)) {
+        int first = p->i;
         Token *name = next(p);
         expect_p(p, ":");
         TypeDecl *d = xalloc(sizeof *d);
@@ -830,6 +844,9 @@ static void type_block(P *p) {
         if (accept_p(p, ":=")) d->init = init_value(p);
         expect_p(p, ";");
         vec_push(&p->u->types, d);
+        Item *it = add_item(p, IT_TYPE, d, d->uname, first);
+        if (d->spec->kind == TS_ENUM)
+            for (int i = 0; i < d->spec->values.n; i++) vec_push(&it->names, ((Token *)d->spec->values.v[i])->up);
     }
     expect_end(p, t, "TYPE", "END_TYPE");
 }
@@ -906,8 +923,17 @@ static void configuration(P *p) {
     c->loc = n->loc;
     while (is_kw(cur(p), "VAR_GLOBAL")) var_block(p, &c->globals, true);
     if (!is_kw(cur(p), "RESOURCE")) {
-        if (is_kw(cur(p), "TASK") || is_kw(cur(p), "PROGRAM"))
-            fatal_at(cur(p)->loc, "a configuration needs a RESOURCE ... ON PLC around its tasks and programs");
+        if (is_kw(cur(p), "TASK") || is_kw(cur(p), "PROGRAM")) {
+            /* IEC 61131-3's single resource: tasks and program instances
+            ** right in the configuration. As matiec: one resource named
+            ** RESOURCE in C, none in the variables' paths (CONFIG.INST.X). */
+            Resource *r = xalloc(sizeof *r);
+            r->name = r->uname = "RESOURCE";
+            r->loc = cur(p)->loc;
+            r->single = true;
+            resource_body(p, r);
+            vec_push(&c->resources, r);
+        }
         expect_end(p, t, "CONFIGURATION", "END_CONFIGURATION");
         vec_push(&p->u->configs, c);
         return;
@@ -962,12 +988,24 @@ void parse_unit(Unit *u, const Source *src, bool from_lib) {
     P p = {toks, n, 0, 0, u, from_lib};
     for (;;) {
         Token *t = cur(&p);
+        int first = p.i;
         if (t->kind == TK_EOF) break;
-        if (t->kind == TK_PRAGMA) { next(&p); vec_push(&u->pragmas, t); continue; }
-        if (is_kw(t, "FUNCTION") || is_kw(t, "FUNCTION_BLOCK") || is_kw(t, "PROGRAM")) pou(&p);
-        else if (is_kw(t, "TYPE")) type_block(&p);
-        else if (is_kw(t, "CONFIGURATION")) configuration(&p);
-        else if (is_p(t, ";")) next(&p);
+        if (t->kind == TK_PRAGMA) {
+            next(&p);
+            vec_push(&u->pragmas, t);
+            add_item(&p, IT_PRAGMA, t, NULL, first);
+            continue;
+        }
+        if (is_kw(t, "FUNCTION") || is_kw(t, "FUNCTION_BLOCK") || is_kw(t, "PROGRAM")) {
+            pou(&p);
+            Pou *d = u->pous.v[u->pous.n - 1];
+            add_item(&p, IT_POU, d, d->uname, first);
+        } else if (is_kw(t, "TYPE")) type_block(&p);
+        else if (is_kw(t, "CONFIGURATION")) {
+            configuration(&p);
+            Config *d = u->configs.v[u->configs.n - 1];
+            add_item(&p, IT_CONFIG, d, d->uname, first);
+        } else if (is_p(t, ";")) next(&p);
         else {
             unsupported_oop(t);
             if (is_one_of(t, sfc_words)) fatal_at(t->loc, "Sequential Function Chart (%s) is not supported by stc", t->up);

@@ -2059,9 +2059,11 @@ static void mark_used(Ctx *c, Pou *p) {
 }
 
 /* " (first declared in FILE:LINE)" when an earlier declaration of a name is
-** in another input file the user wrote, else "". */
+** in another input file the user wrote, " (first declared at line N)" in the
+** same file, else "". */
 static const char *declared_elsewhere(const Sym *old, Loc here) {
-    if (!old || !old->loc.src || old->loc.src == here.src || old->loc.src->name[0] == '<') return "";
+    if (!old || !old->loc.src || old->loc.src->name[0] == '<') return "";
+    if (old->loc.src == here.src) return fmt(" (first declared at line %d)", old->loc.line);
     return fmt(" (first declared in %s:%d)", old->loc.src->name, old->loc.line);
 }
 

@@ -72,6 +72,7 @@ typedef struct Token {
     TimeKind tkind;
     char *sval;
     int slen;
+    size_t pos, end;   /* where it lies in its source text: [pos, end) */
 } Token;
 
 Token *lex(const Source *src, int *count);
@@ -202,6 +203,7 @@ typedef struct Resource {
     Vec tasks;     /* Task */
     Vec progs;     /* ProgInst */
     Vec gsyms;
+    bool single;   /* tasks and programs right in the CONFIGURATION (no RESOURCE) */
 } Resource;
 
 typedef struct Config {
@@ -211,11 +213,27 @@ typedef struct Config {
     Vec gsyms;
 } Config;
 
+/* A top-level declaration as written: a POU, one type of a TYPE block, a
+** CONFIGURATION or a top-level pragma, with its tokens first..last. */
+typedef enum { IT_POU, IT_TYPE, IT_CONFIG, IT_PRAGMA } ItemKind;
+typedef struct Item {
+    ItemKind kind;
+    void *decl;           /* Pou*, TypeDecl*, Config*, Token* */
+    const char *uname;    /* the declared name (NULL for a pragma) */
+    Vec names;            /* further names it declares: an enumeration's values */
+    Token *first, *last;
+    bool library;         /* from a library file (stc -L) */
+    bool dropped;         /* a library declaration the program replaces */
+    int index;            /* join.c's number for it */
+} Item;
+
 typedef struct Unit {
     Vec types;     /* TypeDecl */
     Vec pous;      /* Pou */
     Vec configs;   /* Config */
     Vec pragmas;   /* Token*: top-level {{ }} text */
+    Vec items;     /* Item*: every top-level declaration of the input files, in order */
+    bool library;  /* parse_unit is reading a library file (stc -L) */
 } Unit;
 
 void parse_unit(Unit *u, const Source *src, bool from_lib);
@@ -300,10 +318,24 @@ void sema(Unit *u);
 /* ---- code generation (codegen.c) ---- */
 int codegen(Unit *u, const char *outdir);   /* outdir NULL: generate, write nothing */
 
+/* ---- the project's library and the program's order (join.c) ---- */
+/* A POU or type of a user file that a library file (stc -L) also
+** declares replaces the library's: silently when both read the same token
+** for token, else with a warning naming both places. Library files are
+** parsed with Unit.library set. */
+void replace_library(Unit *u);
+/* Write the kept declarations as one ST file in which every declaration
+** precedes its uses (for compilers that read one file in order, as iec2c),
+** and a line map: "FIRST LAST FROM FILE" per piece (lines FIRST..LAST of
+** out come from FILE's lines FROM...). 0 on success. */
+int stc_join_files(const Source *srcs, int nsrcs, int nlib, const char *out, const char *map);
+
 /* ---- the whole pipeline (compile.c): 0 on success, 1 after errors ---- */
 int stc_compile(const Source *src, const char *outdir);
 /* Several files, one program: declarations of each are visible in all. */
 int stc_compile_files(const Source *srcs, int nsrcs, const char *outdir);
+/* The same, the first nlib files being the project's library (stc -L). */
+int stc_compile_lib(const Source *srcs, int nsrcs, int nlib, const char *outdir);
 
 Type *canon(Type *t);              /* through aliases and subranges */
 

@@ -47,3 +47,13 @@ include tests/getting_started/getting_started.mk
 include tests/docs/docs.mk
 # ---- plcweb: the web page in a headless browser, its security ----
 include tests/web/web.mk
+
+include tests/editor_export/editor_export.mk
+
+include tests/deps/deps.mk
+
+include tests/install/install.mk
+
+include tests/tags/tags.mk
+
+include tests/readme/readme.mk
