@@ -8,6 +8,7 @@ $(eval $(call plcrt_program,multiaxis,$(ST_LIB) examples/multiaxis/multiaxis.st)
 $(eval $(call plcrt_program,preset,$(ST_LIB) examples/preset/preset.st))
 $(eval $(call plcrt_program,plcopen,$(ST_LIB) examples/plcopen/plcopen.st))
 $(eval $(call plcrt_program,aposs,$(ST_LIB) examples/aposs/aposs.st))
+$(eval $(call plcrt_program,cia402,$(ST_LIB) examples/cia402/cia402.st))
 CAM_COMMON := $(ST_LIB) examples/cam_common/camaxis.st
 $(eval $(call plcrt_program,cam_stamping,$(CAM_COMMON) examples/cam_stamping/cam_stamping.st))
 $(eval $(call plcrt_program,cam_dryer,$(ST_LIB) examples/cam_dryer/cam_dryer.st))

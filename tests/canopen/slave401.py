@@ -75,11 +75,11 @@ def build_od(node_id, device_type=CIA401_TYPE, encoder=False):
 class Slave401:
     """A CiA 401 module on a canopen.Network."""
 
-    def __init__(self, network, node_id, device_type=CIA401_TYPE, encoder=False):
+    def __init__(self, network, node_id, device_type=CIA401_TYPE, encoder=False, od=None):
         self.id = node_id
         self.network = network
         self.lock = threading.RLock()
-        self.node = canopen.LocalNode(node_id, build_od(node_id, device_type, encoder))
+        self.node = canopen.LocalNode(node_id, od or build_od(node_id, device_type, encoder))
         network.add_node(self.node)
         # replace the library's NMT handling: ours restores the dictionary
         # and sends the boot-up, as a real module does

@@ -18,3 +18,15 @@ canopen_axis: $(BUILD)/plc/canopen_axis/plcrt | bus-backend
 	  @PY@ tests/canopen/plcrt_axis_test.py $(BUILD)/plc/canopen_axis/plcrt $(CO_BUILD)/uml_axis
 TESTS += canopen_axis
 endif
+
+# the simulated CiA 402 drive against the standard's table and python-canopen's
+# BaseNode402, then plcrt driving two of them with CIA402DRIVE (examples/cia402)
+.PHONY: canopen_drive402 canopen_cia402
+canopen_drive402: | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_drive402 $(BUS_RUN) $(CO_BUILD)/uml_drive402 \
+	  @PY@ tests/canopen/drive402_test.py $(CO_BUILD)/uml_drive402
+TESTS += canopen_drive402
+canopen_cia402: $(BUILD)/plc/cia402/plcrt | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_cia402 $(BUS_RUN) $(CO_BUILD)/uml_cia402 \
+	  @PY@ tests/canopen/plcrt_cia402_test.py $(BUILD)/plc/cia402/plcrt $(CO_BUILD)/uml_cia402
+TESTS += canopen_cia402
