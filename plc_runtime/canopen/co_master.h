@@ -1,6 +1,7 @@
 /* CANopen master: the nodes it manages, their start-up (reset communication,
  * boot-up, device type check, configuration by SDO, NMT start), process data
- * exchange with SYNC, heartbeat consumer, EMCY consumer and bus faults.
+ * exchange with SYNC, heartbeat consumer or node guarding, EMCY consumer and
+ * bus faults.
  * Frame level: frames come in through co_master_rx, frames to send are taken
  * with co_master_pop; co_master_tick advances time-outs. */
 #ifndef CO_MASTER_H
@@ -8,6 +9,7 @@
 
 #include <stdarg.h>
 #include "co_emcy.h"
+#include "co_guard.h"
 #include "co_hb.h"
 #include "co_nmt.h"
 #include "co_pdo.h"
@@ -22,6 +24,8 @@ typedef struct co_node_cfg {
     uint32_t device_type;
     uint16_t hb_producer_ms;        /* written to 0x1017; 0 = leave as is */
     uint16_t hb_consumer_ms;        /* our monitoring time; 0 = off */
+    uint16_t guard_ms;              /* node guarding: guard time (0x100C); 0 = off */
+    uint8_t life_factor;            /* node guarding: life time factor (0x100D) */
     co_pdo_map rpdo[CO_PDO_PER_NODE], tpdo[CO_PDO_PER_NODE];
     uint8_t nextra;                 /* extra SDO writes after the PDOs */
     co_sdo_write extra[8];
@@ -51,6 +55,7 @@ typedef struct co_node {
     uint8_t wbuf[4], ubuf[8];
     co_sdo sdo;
     co_hb hb;
+    co_guard guard;
     co_time deadline, retry_at;
     uint8_t rx[CO_PDO_PER_NODE][8]; /* last TPDO payloads */
     uint8_t tx[CO_PDO_PER_NODE][8]; /* RPDO payloads to send */

@@ -38,6 +38,7 @@ typedef struct bind {
 typedef struct nodecfg_ex {
     char name[32];
     int has_id, pdo_given;  /* pdo_given: some rpdoN/tpdoN key was set */
+    int hb_given;           /* a heartbeat_* key was set */
     plc_loc status, ok;
     int has_status, has_ok;
 } nodecfg_ex;
@@ -275,6 +276,21 @@ static int config(void *vs, const char *section, const char *key, const char *v,
             c->hb_producer_ms = (uint16_t)x;
         else
             c->hb_consumer_ms = (uint16_t)x;
+        ex->hb_given = 1;
+        return 0;
+    }
+    if (!strcmp(key, "guard_time_ms")) {
+        if (num(v, 65535, &x, err, n))
+            return -1;
+        c->guard_ms = (uint16_t)x;
+        return 0;
+    }
+    if (!strcmp(key, "life_factor")) {
+        if (num(v, 255, &x, err, n) || x < 1) {
+            snprintf(err, n, "life factor '%s' must be 1..255", v);
+            return -1;
+        }
+        c->life_factor = (uint8_t)x;
         return 0;
     }
     if ((!strncmp(key, "rpdo", 4) || !strncmp(key, "tpdo", 4)) && key[4] >= '1' && key[4] <= '4' && !key[5]) {
@@ -333,7 +349,7 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         return 0;
     }
     snprintf(err, n, "unknown key (known: id, device_type, heartbeat_producer_ms, "
-             "heartbeat_consumer_ms, rpdo1..4, tpdo1..4, bind, status, ok)");
+             "heartbeat_consumer_ms, guard_time_ms, life_factor, rpdo1..4, tpdo1..4, bind, status, ok)");
     return -1;
 }
 
@@ -469,6 +485,16 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
     for (int i = 0; i < s->nnodes; i++) {
         if (!s->ex[i].has_id) {
             snprintf(err, n, "[%s]: no id", s->ex[i].name);
+            return -1;
+        }
+        co_node_cfg *c = &s->nodes[i].cfg;
+        if (c->guard_ms && !s->ex[i].hb_given) {
+            c->hb_producer_ms = 0;          /* guarded: no heartbeat by default */
+            c->hb_consumer_ms = 0;
+        } else if (c->guard_ms && (c->hb_producer_ms || c->hb_consumer_ms)) {
+            snprintf(err, n, "[%s]: guard_time_ms with a heartbeat: node %u is watched either by node guarding "
+                     "or by its heartbeat (CiA 301); set heartbeat_producer_ms and heartbeat_consumer_ms to 0, "
+                     "or drop guard_time_ms", s->ex[i].name, c->id);
             return -1;
         }
         for (int j = 0; j < i; j++)
