@@ -6,7 +6,7 @@
 ST_PARTS   := $(addprefix st/parts/,epicutil.st epicprof.st ljprof.st poscount.st \
               pidff.st isgdamp.st apossctl.st prssearch.st zlatch.st \
               camcurve.st cambox.st camsync.st)
-ST_DEVICES := $(addprefix st/devices/,epicpos.st apossaxis.st cia402.st)
+ST_DEVICES := $(addprefix st/devices/,epicpos.st apossaxis.st aposscan.st cia402.st)
 ST_PLCOPEN := $(addprefix st/plcopen/,plcopen_axis.st plcopen.st plcopen_aposs.st \
               plcopen_sync.st)
 ST_LIB_SRC := $(ST_PARTS) $(ST_DEVICES) $(ST_PLCOPEN)

@@ -39,6 +39,8 @@ typedef struct nodecfg_ex {
     char name[32];
     int has_id, pdo_given;  /* pdo_given: some rpdoN/tpdoN key was set */
     int hb_given;           /* a heartbeat_* key was set */
+    int guard_given;        /* guard_time_ms was set */
+    int drivetype;          /* seed 000 DRIVETYPE +-91..94 of an APOSS axis on this node, or 0 */
     plc_loc status, ok;
     int has_status, has_ok;
 } nodecfg_ex;
@@ -47,6 +49,7 @@ typedef struct st {
     char ifname[32];
     unsigned sync_every;
     unsigned boot_ms, sdo_ms, wait_ms;
+    unsigned cansynctimer_ms;   /* SYNC period in ms (seed 000 CANSYNCTIMER); 0 = sync_every */
     int nnodes;
     co_node nodes[MAX_NODES];
     nodecfg_ex ex[MAX_NODES];
@@ -237,9 +240,10 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         unsigned *dst = !strcmp(key, "sync_every") ? &s->sync_every
                       : !strcmp(key, "boot_timeout_ms") ? &s->boot_ms
                       : !strcmp(key, "sdo_timeout_ms") ? &s->sdo_ms
-                      : !strcmp(key, "startup_wait_ms") ? &s->wait_ms : NULL;
+                      : !strcmp(key, "startup_wait_ms") ? &s->wait_ms
+                      : !strcmp(key, "cansynctimer_ms") ? &s->cansynctimer_ms : NULL;
         if (!dst) {
-            snprintf(err, n, "unknown key (known: interface, sync_every, boot_timeout_ms, "
+            snprintf(err, n, "unknown key (known: interface, sync_every, cansynctimer_ms, boot_timeout_ms, "
                      "sdo_timeout_ms, startup_wait_ms)");
             return -1;
         }
@@ -283,6 +287,18 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         if (num(v, 65535, &x, err, n))
             return -1;
         c->guard_ms = (uint16_t)x;
+        ex->guard_given = 1;
+        return 0;
+    }
+    if (!strcmp(key, "drivetype")) {
+        char *end;
+        long d = strtol(v, &end, 10);
+        if (end == v || *end || labs(d) < 91 || labs(d) > 94) {
+            snprintf(err, n, "drivetype '%s': seed 000's CANopen I/O module drive types are 91..94 (analog "
+                     "output 1..4, guarded) or -91..-94 (without guarding)", v);
+            return -1;
+        }
+        ex->drivetype = (int)d;
         return 0;
     }
     if (!strcmp(key, "life_factor")) {
@@ -349,7 +365,7 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         return 0;
     }
     snprintf(err, n, "unknown key (known: id, device_type, heartbeat_producer_ms, "
-             "heartbeat_consumer_ms, guard_time_ms, life_factor, rpdo1..4, tpdo1..4, bind, status, ok)");
+             "heartbeat_consumer_ms, guard_time_ms, life_factor, drivetype, rpdo1..4, tpdo1..4, bind, status, ok)");
     return -1;
 }
 
@@ -477,7 +493,6 @@ static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
 static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
 {
     st *s = vs;
-    (void)tick;
     if (!s->nnodes) {
         snprintf(err, n, "no node configured (add a [canopen.NAME] section with id = ...)");
         return -1;
@@ -488,6 +503,15 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
             return -1;
         }
         co_node_cfg *c = &s->nodes[i].cfg;
+        if (s->ex[i].drivetype && !s->ex[i].hb_given) {
+            /* seed 000: the module is guarded (DRIVETYPE > 0) or not watched at all */
+            if (s->ex[i].drivetype > 0 && !s->ex[i].guard_given)
+                c->guard_ms = 100;
+            if (s->ex[i].drivetype < 0)
+                c->guard_ms = 0;
+            c->hb_producer_ms = 0;
+            c->hb_consumer_ms = 0;
+        }
         if (c->guard_ms && !s->ex[i].hb_given) {
             c->hb_producer_ms = 0;          /* guarded: no heartbeat by default */
             c->hb_consumer_ms = 0;
@@ -509,6 +533,15 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
             return -1;
     if (inputs_apart(s, img, err, n))
         return -1;
+    if (s->cansynctimer_ms) {
+        uint64_t p = (uint64_t)s->cansynctimer_ms * 1000000u;
+        if (!tick || p % tick) {
+            snprintf(err, n, "cansynctimer_ms = %u is not a whole number of PLC cycles (%.3f ms): SYNC goes "
+                     "out with the cycle's outputs", s->cansynctimer_ms, (double)tick / 1e6);
+            return -1;
+        }
+        s->sync_every = (unsigned)(p / tick);
+    }
     s->fd = co_can_open(s->ifname, err, n);
     if (s->fd < 0)
         return -1;

@@ -30,3 +30,13 @@ canopen_cia402: $(BUILD)/plc/cia402/plcrt | bus-backend
 	@mk/suite.sh $(RESULTS) canopen_cia402 $(BUS_RUN) $(CO_BUILD)/uml_cia402 \
 	  @PY@ tests/canopen/plcrt_cia402_test.py $(BUILD)/plc/cia402/plcrt $(CO_BUILD)/uml_cia402
 TESTS += canopen_cia402
+
+# seed 000's DRIVETYPE 91: an APOSS axis on the analog output of a guarded CiA 401 module
+ifneq ($(ST_LIB),)
+$(eval $(call plcrt_program,canopen_aposs,$(ST_LIB) tests/canopen/st/canopen_aposs.st))
+.PHONY: canopen_drivetype
+canopen_drivetype: $(BUILD)/plc/canopen_aposs/plcrt | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_drivetype $(BUS_RUN) $(CO_BUILD)/uml_drivetype \
+	  @PY@ tests/canopen/plcrt_drivetype_test.py $(BUILD)/plc/canopen_aposs/plcrt $(CO_BUILD)/uml_drivetype
+TESTS += canopen_drivetype
+endif
