@@ -27,8 +27,8 @@ typedef struct co_node_cfg {
     uint16_t guard_ms;              /* node guarding: guard time (0x100C); 0 = off */
     uint8_t life_factor;            /* node guarding: life time factor (0x100D) */
     co_pdo_map rpdo[CO_PDO_PER_NODE], tpdo[CO_PDO_PER_NODE];
-    uint8_t nextra;                 /* extra SDO writes after the PDOs */
-    co_sdo_write extra[8];
+    uint8_t nextra;                 /* extra SDO writes after the PDOs (e.g. from a DCF) */
+    co_sdo_write extra[64];
 } co_node_cfg;
 
 enum co_phase {

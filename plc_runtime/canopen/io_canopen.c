@@ -18,6 +18,7 @@
 #include "log.h"
 #include "co_master.h"
 #include "co_socketcan.h"
+#include "eds.h"
 
 #define MAX_NODES 32
 #define MAX_BINDS 256
@@ -41,6 +42,7 @@ typedef struct nodecfg_ex {
     int hb_given;           /* a heartbeat_* key was set */
     int guard_given;        /* guard_time_ms was set */
     int drivetype;          /* seed 000 DRIVETYPE +-91..94 of an APOSS axis on this node, or 0 */
+    char eds[256];          /* the node's EDS/DCF file, or "" */
     plc_loc status, ok;
     int has_status, has_ok;
 } nodecfg_ex;
@@ -290,6 +292,14 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         ex->guard_given = 1;
         return 0;
     }
+    if (!strcmp(key, "eds")) {
+        if (!*v || strlen(v) >= sizeof ex->eds) {
+            snprintf(err, n, "'%s': expected the path of the node's EDS or DCF file", v);
+            return -1;
+        }
+        snprintf(ex->eds, sizeof ex->eds, "%s", v);
+        return 0;
+    }
     if (!strcmp(key, "drivetype")) {
         char *end;
         long d = strtol(v, &end, 10);
@@ -365,7 +375,7 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         return 0;
     }
     snprintf(err, n, "unknown key (known: id, device_type, heartbeat_producer_ms, "
-             "heartbeat_consumer_ms, guard_time_ms, life_factor, drivetype, rpdo1..4, tpdo1..4, bind, status, ok)");
+             "heartbeat_consumer_ms, guard_time_ms, life_factor, drivetype, eds, rpdo1..4, tpdo1..4, bind, status, ok)");
     return -1;
 }
 
@@ -490,6 +500,44 @@ static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
     return io_inputs_apart(in, k, err, n);
 }
 
+/* the node's EDS/DCF: device type (unless device_type is given), PDO
+** mappings (unless rpdoN/tpdoN keys are), start-up SDO writes */
+static int use_eds(st *s, int i, char *err, size_t n)
+{
+    co_node_cfg *c = &s->nodes[i].cfg;
+    nodecfg_ex *ex = &s->ex[i];
+    eds_info *e = malloc(sizeof *e);
+    char m[400];
+    if (!e) {
+        snprintf(err, n, "[%s] eds: out of memory", ex->name);
+        return -1;
+    }
+    if (eds_load(ex->eds, c->id, e, m, sizeof m)) {
+        snprintf(err, n, "[%s] eds (node %u): %s", ex->name, c->id, m);
+        free(e);
+        return -1;
+    }
+    if (e->has_device_type && !c->check_type) {
+        c->device_type = e->device_type;
+        c->check_type = 1;
+    }
+    if (e->has_pdo && !ex->pdo_given) {
+        memcpy(c->rpdo, e->rpdo, sizeof c->rpdo);
+        memcpy(c->tpdo, e->tpdo, sizeof c->tpdo);
+    }
+    for (int k = 0; k < e->nwrites; k++) {
+        if (c->nextra >= sizeof c->extra / sizeof c->extra[0]) {
+            snprintf(err, n, "[%s] eds %s: more than %zu start-up writes", ex->name, ex->eds,
+                     sizeof c->extra / sizeof c->extra[0]);
+            free(e);
+            return -1;
+        }
+        c->extra[c->nextra++] = e->w[k];
+    }
+    free(e);
+    return 0;
+}
+
 static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
 {
     st *s = vs;
@@ -503,6 +551,8 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
             return -1;
         }
         co_node_cfg *c = &s->nodes[i].cfg;
+        if (s->ex[i].eds[0] && use_eds(s, i, err, n))
+            return -1;
         if (s->ex[i].drivetype && !s->ex[i].hb_given) {
             /* seed 000: the module is guarded (DRIVETYPE > 0) or not watched at all */
             if (s->ex[i].drivetype > 0 && !s->ex[i].guard_given)

@@ -89,6 +89,10 @@ d5.trans, d6.trans = [], []
 command(0, 1)
 command(1, 1)
 ok = wait_for(lambda: bit(0, POWERED) and bit(1, POWERED), 10)
+report("dcf_written_at_startup", d5.get(0x6065) == 2000 and d6.get(0x6065) == 2000
+       and d5._mapping(0x1600, 0) == [(0x6040, 0, 16), (0x6060, 0, 8), (0x607A, 0, 32)]
+       and d6._mapping(0x1A00, 1) == [(0x606C, 0, 32), (0x603F, 0, 16)],
+       f"0x6065 {d5.get(0x6065)} {d6.get(0x6065)}, RPDO1 {d5._mapping(0x1600, 0)}")
 report("power_on_both", ok and d5.trans == [3, 4] and d6.trans == [3, 4] and d5.st == 5 and d6.st == 5,
        f"transitions {d5.trans} {d6.trans}, states {status(0)} {status(1)}")
 
@@ -155,6 +159,27 @@ ok = wait_for(lambda: d5.st == 3 and d6.st == 3, 5)
 report("power_off_both", ok and d5.trans == [8] and d6.trans == [8], f"{d5.trans} {d6.trans}")
 plc.send_signal(signal.SIGTERM)
 report("plcrt_exits_0", plc.wait(10) == 0)
+
+# ---- bad configuration: one clear message naming the node and the file, exit 2 ----
+def bad_run(name, edit, expect):
+    path = os.path.join(out, f"{name}.ini")
+    with open(path, "w") as f:
+        f.write(edit(text))
+    r = subprocess.run([plcrt, "-c", path], capture_output=True, text=True, timeout=20)
+    msg = (r.stdout + r.stderr).strip().splitlines()
+    hit = [m for m in msg if all(e in m for e in expect)]
+    report(f"bad_config_{name}", r.returncode == 2 and hit, f"status {r.returncode}: {hit or msg[-3:]}")
+
+
+garbled = os.path.join(out, "garbled.eds")
+with open(garbled, "w") as f:
+    f.write("[FileInfo]\nFileName=garbled.eds\n[1000]\nDefaultValue=0x20192\n[1600sub0]\nParameterValue=1\n"
+            "[1600sub1]\nParameterValue=0x60400000\n")
+bad_run("missing_eds", lambda t: t.replace("examples/cia402/drive402.eds", "examples/cia402/nosuch.eds", 1),
+        ["[canopen.drive5] eds (node 5)", "nosuch.eds: No such file"])
+bad_run("garbled_eds", lambda t: t.replace("examples/cia402/drive402.eds", garbled, 1),
+        ["[canopen.drive5] eds (node 5)", "object 0x1600:01", "not a mapping entry"])
+bad_run("node_id_clash", lambda t: t.replace("id = 6", "id = 5"), ["[canopen.drive5] and [canopen.drive6] both have id 5"])
 
 # ---- on the bus: the RPDO1 of node 5 carries the target position (bytes 3..6) ----
 frames = trace.frames(0x205)

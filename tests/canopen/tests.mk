@@ -40,3 +40,15 @@ canopen_drivetype: $(BUILD)/plc/canopen_aposs/plcrt | bus-backend
 	  @PY@ tests/canopen/plcrt_drivetype_test.py $(BUILD)/plc/canopen_aposs/plcrt $(CO_BUILD)/uml_drivetype
 TESTS += canopen_drivetype
 endif
+
+# the EDS/DCF reader (CiA 306), under the sanitizers: it reads vendors' files
+$(CO_BUILD)/eds_test: tests/canopen/eds_test.c $(CO_DIR)/eds.c $(CO_SRC) $(CO_HDR)
+	@mkdir -p $(@D)
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) $(SAN) -I$(CO_DIR) tests/canopen/eds_test.c $(CO_DIR)/eds.c $(CO_SRC) -o $@ \
+	    -linih $$(pkg-config --cflags --libs check)
+.PHONY: canopen_eds
+canopen_eds: $(CO_BUILD)/eds_test
+	@mkdir -p $(CO_BUILD)/eds_files
+	@mk/suite.sh $(RESULTS) canopen_eds $< $(CO_BUILD)/eds_files
+TESTS += canopen_eds
