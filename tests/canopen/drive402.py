@@ -12,7 +12,8 @@ and a motor model stepped at each SYNC:
   HM (6)   method 35/37: the present position becomes 0 (plus home_at)
 
 A load can be blocked (stuck): in CSP the following error then exceeds
-0x6065 and the drive faults with EMCY 0x8611, as a real drive does.  The
+0x6065 and the drive faults with EMCY 0x8611, as a real drive set to fault
+on a following error does.  The
 controlword is taken at each SYNC (from the RPDO) and at each SDO write, so
 a master using SDO only (python-canopen's BaseNode402) drives it as well.
 """
@@ -236,8 +237,6 @@ class Drive402(Slave401):
         if self.st == 5:
             if self.mode_disp == 8:
                 sw |= 0x1000
-                if self.stuck:
-                    sw |= 0x2000
             elif self.mode_disp == 1:
                 if self.pp_ack:
                     sw |= 0x1000
