@@ -21,4 +21,9 @@ ALL += $(EXAMPLES:%=$(BUILD)/plc/%/plcrt)
 .PHONY: $(EXAMPLES:%=run-%)
 $(EXAMPLES:%=run-%): run-%: $(BUILD)/plc/%/plcrt
 	@mk/run_fg.sh $(BUILD)/plc/$*/plcrt -c $(or $(INI),examples/$*/$*.ini)
+# two simulated CiA 402 drives on vcan0 with the example (docs/drives.md)
+ALL += $(BUILD)/plc/cia402/plcrt
+.PHONY: run-cia402
+run-cia402: $(BUILD)/plc/cia402/plcrt
+	@examples/cia402/run.sh $< $(or $(INI),examples/cia402/cia402.ini)
 RUN_DEMO := run-epicpos

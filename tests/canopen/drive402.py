@@ -258,3 +258,31 @@ class Drive402(Slave401):
     @property
     def state_name(self):
         return STATE_NAMES[self.st]
+
+
+def main():
+    """Run simulated drives on a CAN interface until SIGINT/SIGTERM:
+        python3 tests/canopen/drive402.py [--interface vcan0] NODE_ID..."""
+    import argparse
+    import signal
+
+    from slave401 import connect
+    p = argparse.ArgumentParser(description="simulated CiA 402 drives (CSP, CSV, PP, PV, homing)")
+    p.add_argument("--interface", default="vcan0")
+    p.add_argument("nodes", nargs="+", type=int)
+    a = p.parse_args()
+    try:
+        net = connect(a.interface)
+    except OSError as e:
+        raise SystemExit(f"drive402: CAN interface {a.interface}: {e} (docs/drives.md says how to make a vcan0)")
+    drives = [Drive402(net, n) for n in a.nodes]
+    print(f"drive402: {len(drives)} simulated CiA 402 drive(s) on {a.interface}: nodes "
+          + ", ".join(str(n) for n in a.nodes), flush=True)
+    signal.sigwait({signal.SIGINT, signal.SIGTERM})
+    net.disconnect()
+
+
+if __name__ == "__main__":
+    import signal as _s
+    _s.pthread_sigmask(_s.SIG_BLOCK, {_s.SIGINT, _s.SIGTERM})
+    main()
