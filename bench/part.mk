@@ -82,3 +82,11 @@ bench-aposs: $(STC) $(ST_LIB) $(BUILD)/plc/aposs/plcrt
 	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
 	  bench/aposs/bench.sh $(BENCH_B)/aposs $(abspath $(ST_LIB)) 3000 5 $(abspath $(BUILD)/plc/aposs/plcrt)
 BENCHES += bench-aposs
+
+# CIA402DRIVE: scan cost per drive in CSP, and CiA 402 drives per 1 Mbit/s
+# bus at a 1 ms and a 4 ms SYNC period (bench/cia402/)
+.PHONY: bench-cia402
+bench-cia402: $(STC) $(ST_LIB)
+	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
+	  bench/cia402/bench.sh $(BENCH_B)/cia402 $(abspath $(ST_LIB)) 3000 5
+BENCHES += bench-cia402
