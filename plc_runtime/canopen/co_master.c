@@ -374,11 +374,19 @@ void co_master_rx(co_master *m, const co_frame *f, co_time now)
             memcpy(n->rx[k], f->data, f->len);
             n->rx_new |= (uint8_t)(1 << k);
             n->rx_pdos++;
-        } else if (n->phase == CO_PH_RUN && n->short_pdos++ % 1000 == 0) {
-            /* its inputs keep their last values: never silently */
-            logf_(m, 1, "node %u: TPDO%u of %u byte(s), its mapping needs %u: ignored, the inputs it carries keep "
-                  "their last values (%u such so far; the node's mapping 0x%04X differs from the configuration's "
-                  "tpdo%u)", n->cfg.id, k + 1, (unsigned)f->len, need, (unsigned)n->short_pdos, 0x1A00 + k, k + 1);
+            n->short_mask &= (uint8_t)~(1 << k);
+            if (!n->short_mask)
+                n->fault &= (uint8_t)~CO_F_SHORT;
+        } else if (n->phase == CO_PH_RUN) {
+            /* its inputs keep their last values: never silently, and the
+             * node's status says they are stale (bit 6) until a good one */
+            n->short_mask |= (uint8_t)(1 << k);
+            n->fault |= CO_F_SHORT;
+            if (n->short_pdos++ % 1000 == 0)
+                logf_(m, 1, "node %u: TPDO%u of %u byte(s), its mapping needs %u: ignored, the inputs it carries "
+                      "keep their last values (%u such so far; the node's mapping 0x%04X differs from the "
+                      "configuration's tpdo%u)", n->cfg.id, k + 1, (unsigned)f->len, need, (unsigned)n->short_pdos,
+                      0x1A00 + k, k + 1);
         }
     }
 }

@@ -43,7 +43,8 @@ enum {
     CO_F_SDO = 1 << 2,              /* last SDO transfer aborted or timed out */
     CO_F_START = 1 << 3,            /* start-up failed (no answer, wrong type) */
     CO_F_TYPE = 1 << 4,             /* device type differs */
-    CO_F_BOOT = 1 << 5              /* unexpected boot-up seen (latched) */
+    CO_F_BOOT = 1 << 5,             /* unexpected boot-up seen (latched) */
+    CO_F_SHORT = 1 << 6             /* the last TPDO was shorter than its mapping: inputs stale */
 };
 
 typedef struct co_node {
@@ -67,6 +68,7 @@ typedef struct co_node {
     uint32_t last_abort;
     uint32_t rx_pdos, tx_pdos;
     uint32_t short_pdos;            /* TPDOs shorter than their mapping: ignored, reported */
+    uint8_t short_mask;             /* bit per TPDO whose last frame was short */
     co_emcy last_emcy;
 } co_node;
 

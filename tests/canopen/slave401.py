@@ -98,6 +98,7 @@ class Slave401:
         self.guard_rtrs = 0
         self.toggle = 0
         network.notifier.add_listener(_GuardListener(self))
+        self.short_tpdo = 0          # > 0: TPDOs cut to this many bytes
         self.syncs = 0
         self.rpdos = 0
         self.on_sync = None          # hook run before the TPDOs go out
@@ -201,7 +202,10 @@ class Slave401:
                     raw = int.from_bytes(self.node.get_data(index, sub), "little")
                     word |= (raw & ((1 << bits) - 1)) << off
                     off += bits
-            self.network.send_message(cobid & 0x7FF, word.to_bytes((off + 7) // 8, "little"))
+            data = word.to_bytes((off + 7) // 8, "little")
+            if self.short_tpdo:                     # a broken node: TPDOs cut short
+                data = data[:self.short_tpdo]
+            self.network.send_message(cobid & 0x7FF, data)
 
 
 class _GuardListener(can.Listener):

@@ -278,6 +278,11 @@ START_TEST(process_data_and_sync)
     co_master_rx(&m, &t, T0);
     ck_assert_str_eq(logbuf, "");
     ck_assert_uint_eq(n[0].short_pdos, 2);
+    /* the node's status says its inputs are stale (bit 6) until a good one */
+    ck_assert(n[0].fault & CO_F_SHORT);
+    t = frame(0x181, 8, (uint8_t[]){ 1, 2, 3, 4, 5, 6, 7, 8 });
+    co_master_rx(&m, &t, T0);
+    ck_assert(!(n[0].fault & CO_F_SHORT));
 }
 END_TEST
 
