@@ -98,3 +98,10 @@ bench-web: $(BUILD)/plc/epicpos/plcrt
 	@mkdir -p $(BENCH_B)/web
 	python3 bench/web/bench.py $(BUILD)/plc/epicpos/plcrt examples/epicpos/epicpos.ini $(abspath $(BENCH_B))/web
 BENCHES += bench-web
+# CIA402DRIVE: scan cost per drive in CSP, and CiA 402 drives per 1 Mbit/s
+# bus at a 1 ms and a 4 ms SYNC period (bench/cia402/)
+.PHONY: bench-cia402
+bench-cia402: $(STC) $(ST_LIB)
+	@env STC="$(abspath $(STC))" STC_INC="$(abspath $(STC_INC))" CC="$(CC)" CFLAGS="$(CFLAGS)" \
+	  bench/cia402/bench.sh $(BENCH_B)/cia402 $(abspath $(ST_LIB)) 3000 5
+BENCHES += bench-cia402

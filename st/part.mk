@@ -6,9 +6,9 @@
 ST_PARTS   := $(addprefix st/parts/,epicutil.st epicprof.st ljprof.st poscount.st \
               pidff.st isgdamp.st apossctl.st prssearch.st zlatch.st \
               camcurve.st cambox.st camsync.st)
-ST_DEVICES := $(addprefix st/devices/,epicpos.st apossaxis.st)
+ST_DEVICES := $(addprefix st/devices/,epicpos.st apossaxis.st aposscan.st cia402.st)
 ST_PLCOPEN := $(addprefix st/plcopen/,plcopen_types.st plcopen_axis.st plcopen_core.st plcopen.st \
-              plcopen_epicpos.st plcopen_aposs.st \
+              plcopen_epicpos.st plcopen_aposs.st plcopen_cia402.st \
               plcopen_sync.st)
 ST_LIB_SRC := $(ST_PARTS) $(ST_DEVICES) $(ST_PLCOPEN)
 ST_LIB     := $(BUILD)/st/epicpos.st

@@ -30,6 +30,8 @@ include tests/examples/tests.mk
 include tests/apossctl/apossctl.mk
 # ---- apossaxis: the APOSS-style axis device ----
 include tests/apossaxis/apossaxis.mk
+# ---- cia402: the CiA 402 drive device ----
+include tests/cia402/cia402.mk
 
 # ---- isg: the ISG damping part (seed 004) ----
 include tests/isg/isg.mk

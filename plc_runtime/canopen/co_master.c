@@ -54,6 +54,7 @@ void co_node_cfg_cia401(co_node_cfg *c, uint8_t id)
     c->device_type = 0x00000191;        /* CiA 401 */
     c->hb_producer_ms = 100;
     c->hb_consumer_ms = 250;
+    c->life_factor = 3;
     for (unsigned i = 0; i < CO_PDO_PER_NODE; i++) {
         co_pdo_cia401_default(0, i, &c->rpdo[i]);
         co_pdo_cia401_default(1, i, &c->tpdo[i]);
@@ -76,6 +77,7 @@ void co_master_init(co_master *m, co_node *nodes, int nnodes, unsigned sync_ever
         n->cfg = c;
         co_sdo_init(&n->sdo, c.id, m->sdo_timeout);
         co_hb_init(&n->hb, c.id, (co_time)c.hb_consumer_ms * CO_MS);
+        co_guard_init(&n->guard, c.id, (co_time)c.guard_ms * CO_MS, c.life_factor);
     }
 }
 
@@ -100,6 +102,11 @@ static void plan(co_node *n)
         }
     if (n->cfg.hb_producer_ms && k < CO_MAX_WRITES)
         n->w[k++] = (co_sdo_write){ 0x1017, 0, 2, n->cfg.hb_producer_ms };
+    if (n->cfg.guard_ms && k + 1 < CO_MAX_WRITES) {
+        /* the node guards the master with the same numbers (life guarding) */
+        n->w[k++] = (co_sdo_write){ 0x100C, 0, 2, n->cfg.guard_ms };
+        n->w[k++] = (co_sdo_write){ 0x100D, 0, 1, n->guard.life };
+    }
     for (unsigned i = 0; i < n->cfg.nextra && k < CO_MAX_WRITES; i++)
         n->w[k++] = n->cfg.extra[i];
     n->nw = (uint8_t)k;
@@ -123,6 +130,7 @@ static void fail(co_master *m, co_node *n, co_time now, int flag)
 
 static void reset_comm(co_master *m, co_node *n, co_time now)
 {
+    n->guard.active = 0;            /* the node's toggle starts again at 0 */
     n->phase = CO_PH_WAIT_BOOT;
     n->deadline = now + m->boot_timeout;
     n->starts++;
@@ -151,6 +159,7 @@ static void next_write(co_master *m, co_node *n, co_time now)
         n->hb.active = 1;
         n->hb.lost = 0;
         n->hb.last = now;
+        co_guard_start(&n->guard, now);
         logf_(m, 0, "node %u: configured (%u SDO writes) and started", n->cfg.id, n->nw);
         return;
     }
@@ -277,6 +286,34 @@ void co_master_bus(co_master *m, int state, const char *why)
     m->bus = (uint8_t)state;
 }
 
+/* an answer to node guarding */
+static void guard_rx(co_master *m, co_node *n, const co_frame *f, co_time now)
+{
+    co_guard *g = &n->guard;
+    switch (co_guard_rx(g, f, now)) {
+    case CO_GUARD_BACK:
+        if (n->phase == CO_PH_LOST) {
+            logf_(m, 0, "node %u: answers node guarding again (%s): restarting it", n->cfg.id,
+                  co_nmt_state_name(g->state));
+            reset_comm(m, n, now);
+        }
+        break;
+    case CO_GUARD_TOGGLE:
+        if (g->toggle_errors % 100 == 1)
+            logf_(m, 1, "node %u: node guarding answer with toggle bit %u, expected %u: not an answer "
+                  "(%u so far)", n->cfg.id, (unsigned)(f->data[0] >> 7), (unsigned)(g->toggle >> 7),
+                  (unsigned)g->toggle_errors);
+        break;
+    case CO_GUARD_STATE:
+        if (n->phase == CO_PH_RUN && g->state != CO_ST_OPERATIONAL && g->answers > 1)
+            logf_(m, 1, "node %u: left operational, now %s (node guarding)", n->cfg.id,
+                  co_nmt_state_name(g->state));
+        break;
+    default:
+        break;
+    }
+}
+
 void co_master_rx(co_master *m, const co_frame *f, co_time now)
 {
     if (f->id & CO_ERR_FLAG) {
@@ -291,7 +328,9 @@ void co_master_rx(co_master *m, const co_frame *f, co_time now)
     if (!n || f->rtr)
         return;
     co_frame out;
-    if (fc == CO_FC_HB) {
+    if (fc == CO_FC_HB && n->guard.period && f->len >= 1 && (f->data[0] & 0x7F) != 0) {
+        guard_rx(m, n, f, now);
+    } else if (fc == CO_FC_HB) {
         int prev_op = n->was_op;
         n->was_op = f->len >= 1 && n->phase == CO_PH_RUN && (f->data[0] & 0x7F) == CO_ST_OPERATIONAL;
         switch (co_hb_rx(&n->hb, f, now)) {
@@ -335,11 +374,19 @@ void co_master_rx(co_master *m, const co_frame *f, co_time now)
             memcpy(n->rx[k], f->data, f->len);
             n->rx_new |= (uint8_t)(1 << k);
             n->rx_pdos++;
-        } else if (n->phase == CO_PH_RUN && n->short_pdos++ % 1000 == 0) {
-            /* its inputs keep their last values: never silently */
-            logf_(m, 1, "node %u: TPDO%u of %u byte(s), its mapping needs %u: ignored, the inputs it carries keep "
-                  "their last values (%u such so far; the node's mapping 0x%04X differs from the configuration's "
-                  "tpdo%u)", n->cfg.id, k + 1, (unsigned)f->len, need, (unsigned)n->short_pdos, 0x1A00 + k, k + 1);
+            n->short_mask &= (uint8_t)~(1 << k);
+            if (!n->short_mask)
+                n->fault &= (uint8_t)~CO_F_SHORT;
+        } else if (n->phase == CO_PH_RUN) {
+            /* its inputs keep their last values: never silently, and the
+             * node's status says they are stale (bit 6) until a good one */
+            n->short_mask |= (uint8_t)(1 << k);
+            n->fault |= CO_F_SHORT;
+            if (n->short_pdos++ % 1000 == 0)
+                logf_(m, 1, "node %u: TPDO%u of %u byte(s), its mapping needs %u: ignored, the inputs it carries "
+                      "keep their last values (%u such so far; the node's mapping 0x%04X differs from the "
+                      "configuration's tpdo%u)", n->cfg.id, k + 1, (unsigned)f->len, need, (unsigned)n->short_pdos,
+                      0x1A00 + k, k + 1);
         }
     }
 }
@@ -366,7 +413,24 @@ void co_master_tick(co_master *m, co_time now)
             }
             break;
         case CO_PH_RUN:
-            if (co_hb_tick(&n->hb, now) == CO_HB_LOST) {
+        case CO_PH_LOST:
+            if (n->guard.period) {
+                int rtr;
+                int ev = co_guard_tick(&n->guard, now, &out, &rtr);
+                if (rtr)
+                    push(m, &out);
+                if (ev == CO_GUARD_LOST && n->phase == CO_PH_RUN) {
+                    n->phase = CO_PH_LOST;
+                    n->fault |= CO_F_LOST;
+                    n->hb_lost++;
+                    memset(n->tx, 0, sizeof n->tx);
+                    logf_(m, 1, "node %u: no answer to node guarding for %u ms (guard time %u ms x life "
+                          "factor %u): outputs to safe state", n->cfg.id,
+                          (unsigned)n->cfg.guard_ms * n->guard.life, n->cfg.guard_ms, n->guard.life);
+                }
+                break;
+            }
+            if (n->phase == CO_PH_RUN && co_hb_tick(&n->hb, now) == CO_HB_LOST) {
                 n->phase = CO_PH_LOST;
                 n->fault |= CO_F_LOST;
                 n->hb_lost++;

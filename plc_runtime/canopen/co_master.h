@@ -1,6 +1,7 @@
 /* CANopen master: the nodes it manages, their start-up (reset communication,
  * boot-up, device type check, configuration by SDO, NMT start), process data
- * exchange with SYNC, heartbeat consumer, EMCY consumer and bus faults.
+ * exchange with SYNC, heartbeat consumer or node guarding, EMCY consumer and
+ * bus faults.
  * Frame level: frames come in through co_master_rx, frames to send are taken
  * with co_master_pop; co_master_tick advances time-outs. */
 #ifndef CO_MASTER_H
@@ -8,6 +9,7 @@
 
 #include <stdarg.h>
 #include "co_emcy.h"
+#include "co_guard.h"
 #include "co_hb.h"
 #include "co_nmt.h"
 #include "co_pdo.h"
@@ -22,9 +24,11 @@ typedef struct co_node_cfg {
     uint32_t device_type;
     uint16_t hb_producer_ms;        /* written to 0x1017; 0 = leave as is */
     uint16_t hb_consumer_ms;        /* our monitoring time; 0 = off */
+    uint16_t guard_ms;              /* node guarding: guard time (0x100C); 0 = off */
+    uint8_t life_factor;            /* node guarding: life time factor (0x100D) */
     co_pdo_map rpdo[CO_PDO_PER_NODE], tpdo[CO_PDO_PER_NODE];
-    uint8_t nextra;                 /* extra SDO writes after the PDOs */
-    co_sdo_write extra[8];
+    uint8_t nextra;                 /* extra SDO writes after the PDOs (e.g. from a DCF) */
+    co_sdo_write extra[64];
 } co_node_cfg;
 
 enum co_phase {
@@ -39,7 +43,8 @@ enum {
     CO_F_SDO = 1 << 2,              /* last SDO transfer aborted or timed out */
     CO_F_START = 1 << 3,            /* start-up failed (no answer, wrong type) */
     CO_F_TYPE = 1 << 4,             /* device type differs */
-    CO_F_BOOT = 1 << 5              /* unexpected boot-up seen (latched) */
+    CO_F_BOOT = 1 << 5,             /* unexpected boot-up seen (latched) */
+    CO_F_SHORT = 1 << 6             /* the last TPDO was shorter than its mapping: inputs stale */
 };
 
 typedef struct co_node {
@@ -51,6 +56,7 @@ typedef struct co_node {
     uint8_t wbuf[4], ubuf[8];
     co_sdo sdo;
     co_hb hb;
+    co_guard guard;
     co_time deadline, retry_at;
     uint8_t rx[CO_PDO_PER_NODE][8]; /* last TPDO payloads */
     uint8_t tx[CO_PDO_PER_NODE][8]; /* RPDO payloads to send */
@@ -62,6 +68,7 @@ typedef struct co_node {
     uint32_t last_abort;
     uint32_t rx_pdos, tx_pdos;
     uint32_t short_pdos;            /* TPDOs shorter than their mapping: ignored, reported */
+    uint8_t short_mask;             /* bit per TPDO whose last frame was short */
     co_emcy last_emcy;
 } co_node;
 

@@ -18,6 +18,7 @@
 #include "log.h"
 #include "co_master.h"
 #include "co_socketcan.h"
+#include "eds.h"
 
 #define MAX_NODES 32
 #define MAX_BINDS 256
@@ -38,6 +39,10 @@ typedef struct bind {
 typedef struct nodecfg_ex {
     char name[32];
     int has_id, pdo_given;  /* pdo_given: some rpdoN/tpdoN key was set */
+    int hb_given;           /* a heartbeat_* key was set */
+    int guard_given;        /* guard_time_ms was set */
+    int drivetype;          /* seed 000 DRIVETYPE +-91..94 of an APOSS axis on this node, or 0 */
+    char eds[256];          /* the node's EDS/DCF file, or "" */
     plc_loc status, ok;
     int has_status, has_ok;
 } nodecfg_ex;
@@ -46,6 +51,7 @@ typedef struct st {
     char ifname[32];
     unsigned sync_every;
     unsigned boot_ms, sdo_ms, wait_ms;
+    unsigned cansynctimer_ms;   /* SYNC period in ms (seed 000 CANSYNCTIMER); 0 = sync_every */
     int nnodes;
     co_node nodes[MAX_NODES];
     nodecfg_ex ex[MAX_NODES];
@@ -236,9 +242,10 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         unsigned *dst = !strcmp(key, "sync_every") ? &s->sync_every
                       : !strcmp(key, "boot_timeout_ms") ? &s->boot_ms
                       : !strcmp(key, "sdo_timeout_ms") ? &s->sdo_ms
-                      : !strcmp(key, "startup_wait_ms") ? &s->wait_ms : NULL;
+                      : !strcmp(key, "startup_wait_ms") ? &s->wait_ms
+                      : !strcmp(key, "cansynctimer_ms") ? &s->cansynctimer_ms : NULL;
         if (!dst) {
-            snprintf(err, n, "unknown key (known: interface, sync_every, boot_timeout_ms, "
+            snprintf(err, n, "unknown key (known: interface, sync_every, cansynctimer_ms, boot_timeout_ms, "
                      "sdo_timeout_ms, startup_wait_ms)");
             return -1;
         }
@@ -275,6 +282,41 @@ static int config(void *vs, const char *section, const char *key, const char *v,
             c->hb_producer_ms = (uint16_t)x;
         else
             c->hb_consumer_ms = (uint16_t)x;
+        ex->hb_given = 1;
+        return 0;
+    }
+    if (!strcmp(key, "guard_time_ms")) {
+        if (num(v, 65535, &x, err, n))
+            return -1;
+        c->guard_ms = (uint16_t)x;
+        ex->guard_given = 1;
+        return 0;
+    }
+    if (!strcmp(key, "eds")) {
+        if (!*v || strlen(v) >= sizeof ex->eds) {
+            snprintf(err, n, "'%s': expected the path of the node's EDS or DCF file", v);
+            return -1;
+        }
+        snprintf(ex->eds, sizeof ex->eds, "%s", v);
+        return 0;
+    }
+    if (!strcmp(key, "drivetype")) {
+        char *end;
+        long d = strtol(v, &end, 10);
+        if (end == v || *end || labs(d) < 91 || labs(d) > 94) {
+            snprintf(err, n, "drivetype '%s': seed 000's CANopen I/O module drive types are 91..94 (analog "
+                     "output 1..4, guarded) or -91..-94 (without guarding)", v);
+            return -1;
+        }
+        ex->drivetype = (int)d;
+        return 0;
+    }
+    if (!strcmp(key, "life_factor")) {
+        if (num(v, 255, &x, err, n) || x < 1) {
+            snprintf(err, n, "life factor '%s' must be 1..255", v);
+            return -1;
+        }
+        c->life_factor = (uint8_t)x;
         return 0;
     }
     if ((!strncmp(key, "rpdo", 4) || !strncmp(key, "tpdo", 4)) && key[4] >= '1' && key[4] <= '4' && !key[5]) {
@@ -333,7 +375,7 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         return 0;
     }
     snprintf(err, n, "unknown key (known: id, device_type, heartbeat_producer_ms, "
-             "heartbeat_consumer_ms, rpdo1..4, tpdo1..4, bind, status, ok)");
+             "heartbeat_consumer_ms, guard_time_ms, life_factor, drivetype, eds, rpdo1..4, tpdo1..4, bind, status, ok)");
     return -1;
 }
 
@@ -464,10 +506,47 @@ static int inputs_apart(st *s, plc_image *img, char *err, size_t n)
     return io_inputs_apart(in, list_inputs(s, img, in, (int)(sizeof in / sizeof in[0])), err, n);
 }
 
+/* the node's EDS/DCF: device type (unless device_type is given), PDO
+** mappings (unless rpdoN/tpdoN keys are), start-up SDO writes */
+static int use_eds(st *s, int i, char *err, size_t n)
+{
+    co_node_cfg *c = &s->nodes[i].cfg;
+    nodecfg_ex *ex = &s->ex[i];
+    eds_info *e = malloc(sizeof *e);
+    char m[400];
+    if (!e) {
+        snprintf(err, n, "[%s] eds: out of memory", ex->name);
+        return -1;
+    }
+    if (eds_load(ex->eds, c->id, e, m, sizeof m)) {
+        snprintf(err, n, "[%s] eds (node %u): %s", ex->name, c->id, m);
+        free(e);
+        return -1;
+    }
+    if (e->has_device_type && !c->check_type) {
+        c->device_type = e->device_type;
+        c->check_type = 1;
+    }
+    if (e->has_pdo && !ex->pdo_given) {
+        memcpy(c->rpdo, e->rpdo, sizeof c->rpdo);
+        memcpy(c->tpdo, e->tpdo, sizeof c->tpdo);
+    }
+    for (int k = 0; k < e->nwrites; k++) {
+        if (c->nextra >= sizeof c->extra / sizeof c->extra[0]) {
+            snprintf(err, n, "[%s] eds %s: more than %zu start-up writes", ex->name, ex->eds,
+                     sizeof c->extra / sizeof c->extra[0]);
+            free(e);
+            return -1;
+        }
+        c->extra[c->nextra++] = e->w[k];
+    }
+    free(e);
+    return 0;
+}
+
 static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
 {
     st *s = vs;
-    (void)tick;
     if (!s->nnodes) {
         snprintf(err, n, "no node configured (add a [canopen.NAME] section with id = ...)");
         return -1;
@@ -475,6 +554,27 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
     for (int i = 0; i < s->nnodes; i++) {
         if (!s->ex[i].has_id) {
             snprintf(err, n, "[%s]: no id", s->ex[i].name);
+            return -1;
+        }
+        co_node_cfg *c = &s->nodes[i].cfg;
+        if (s->ex[i].eds[0] && use_eds(s, i, err, n))
+            return -1;
+        if (s->ex[i].drivetype && !s->ex[i].hb_given) {
+            /* seed 000: the module is guarded (DRIVETYPE > 0) or not watched at all */
+            if (s->ex[i].drivetype > 0 && !s->ex[i].guard_given)
+                c->guard_ms = 100;
+            if (s->ex[i].drivetype < 0)
+                c->guard_ms = 0;
+            c->hb_producer_ms = 0;
+            c->hb_consumer_ms = 0;
+        }
+        if (c->guard_ms && !s->ex[i].hb_given) {
+            c->hb_producer_ms = 0;          /* guarded: no heartbeat by default */
+            c->hb_consumer_ms = 0;
+        } else if (c->guard_ms && (c->hb_producer_ms || c->hb_consumer_ms)) {
+            snprintf(err, n, "[%s]: guard_time_ms with a heartbeat: node %u is watched either by node guarding "
+                     "or by its heartbeat (CiA 301); set heartbeat_producer_ms and heartbeat_consumer_ms to 0, "
+                     "or drop guard_time_ms", s->ex[i].name, c->id);
             return -1;
         }
         for (int j = 0; j < i; j++)
@@ -489,6 +589,15 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
             return -1;
     if (inputs_apart(s, img, err, n))
         return -1;
+    if (s->cansynctimer_ms) {
+        uint64_t p = (uint64_t)s->cansynctimer_ms * 1000000u;
+        if (!tick || p % tick) {
+            snprintf(err, n, "cansynctimer_ms = %u is not a whole number of PLC cycles (%.3f ms): SYNC goes "
+                     "out with the cycle's outputs", s->cansynctimer_ms, (double)tick / 1e6);
+            return -1;
+        }
+        s->sync_every = (unsigned)(p / tick);
+    }
     s->fd = co_can_open(s->ifname, err, n);
     if (s->fd < 0)
         return -1;

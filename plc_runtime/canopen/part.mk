@@ -88,7 +88,11 @@ $(CO_BUILD)/io_canopen.o: $(CO_DIR)/io_canopen.c $(CO_HDR) $(wildcard plc_runtim
 	@mkdir -p $(@D)
 	$(call say,CC,$<)
 	$(Q)$(CC) $(CFLAGS) -Iplc_runtime -I$(CO_DIR) -c $< -o $@
-CO_BACKEND := $(CO_BUILD)/io_canopen.o $(CO_LIB)
+$(CO_BUILD)/eds.o: $(CO_DIR)/eds.c $(CO_HDR)
+	@mkdir -p $(@D)
+	$(call say,CC,$<)
+	$(Q)$(CC) $(CFLAGS) -I$(CO_DIR) -c $< -o $@
+CO_BACKEND := $(CO_BUILD)/io_canopen.o $(CO_BUILD)/eds.o $(CO_LIB)
 endif
 
 # benchmarks: SYNC-to-RPDO latency, PDO throughput, bus load (bench/canopen)

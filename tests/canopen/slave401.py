@@ -12,6 +12,7 @@ import subprocess
 import threading
 import time
 
+import can
 import canopen
 from canopen.objectdictionary import ODArray, ODRecord, ODVariable, ObjectDictionary
 from canopen.objectdictionary import datatypes as dt
@@ -42,6 +43,8 @@ def build_od(node_id, device_type=CIA401_TYPE, encoder=False):
     od.add_object(var("device type", 0x1000, 0, dt.UNSIGNED32, "ro", device_type))
     od.add_object(var("error register", 0x1001, 0, dt.UNSIGNED8, "ro", 0))
     od.add_object(var("producer heartbeat time", 0x1017, 0, dt.UNSIGNED16, "rw", 0))
+    od.add_object(var("guard time", 0x100C, 0, dt.UNSIGNED16, "rw", 0))
+    od.add_object(var("life time factor", 0x100D, 0, dt.UNSIGNED8, "rw", 0))
     name = ODVariable("device name", 0x1008, 0)
     name.data_type = dt.VISIBLE_STRING
     name.access_type = "const"
@@ -75,11 +78,11 @@ def build_od(node_id, device_type=CIA401_TYPE, encoder=False):
 class Slave401:
     """A CiA 401 module on a canopen.Network."""
 
-    def __init__(self, network, node_id, device_type=CIA401_TYPE, encoder=False):
+    def __init__(self, network, node_id, device_type=CIA401_TYPE, encoder=False, od=None):
         self.id = node_id
         self.network = network
         self.lock = threading.RLock()
-        self.node = canopen.LocalNode(node_id, build_od(node_id, device_type, encoder))
+        self.node = canopen.LocalNode(node_id, od or build_od(node_id, device_type, encoder))
         network.add_node(self.node)
         # replace the library's NMT handling: ours restores the dictionary
         # and sends the boot-up, as a real module does
@@ -88,6 +91,14 @@ class Slave401:
         network.subscribe(0x080, self._on_sync)
         for i in range(4):
             network.subscribe(0x200 + 0x100 * i + node_id, self._on_rpdo)
+        # node guarding: python-canopen drops remote frames, so the RTRs are
+        # taken from python-can directly; the answer is the NMT state with
+        # the toggle bit, which starts at 0 after each boot
+        self.guard_answer = True
+        self.guard_rtrs = 0
+        self.toggle = 0
+        network.notifier.add_listener(_GuardListener(self))
+        self.short_tpdo = 0          # > 0: TPDOs cut to this many bytes
         self.syncs = 0
         self.rpdos = 0
         self.on_sync = None          # hook run before the TPDOs go out
@@ -123,6 +134,7 @@ class Slave401:
             else:
                 self.node.data_store.clear()
         nmt._state = 0
+        self.toggle = 0
         self.network.send_message(0x700 + self.id, [0])      # boot-up
         nmt._state = 127
         hb = self.get(0x1017)
@@ -190,7 +202,24 @@ class Slave401:
                     raw = int.from_bytes(self.node.get_data(index, sub), "little")
                     word |= (raw & ((1 << bits) - 1)) << off
                     off += bits
-            self.network.send_message(cobid & 0x7FF, word.to_bytes((off + 7) // 8, "little"))
+            data = word.to_bytes((off + 7) // 8, "little")
+            if self.short_tpdo:                     # a broken node: TPDOs cut short
+                data = data[:self.short_tpdo]
+            self.network.send_message(cobid & 0x7FF, data)
+
+
+class _GuardListener(can.Listener):
+    def __init__(self, slave):
+        self.slave = slave
+
+    def on_message_received(self, msg):
+        s = self.slave
+        if not msg.is_remote_frame or msg.arbitration_id != 0x700 + s.id:
+            return
+        s.guard_rtrs += 1
+        if s.guard_answer:
+            s.network.send_message(0x700 + s.id, [s.state | s.toggle])
+            s.toggle ^= 0x80
 
 
 class Axis(Slave401):
@@ -250,6 +279,8 @@ class CanDump:
                 if len(parts) != 3 or "#" not in parts[2]:
                     continue
                 ident, data = parts[2].split("#", 1)
+                if data.startswith("R"):            # a remote frame (node guarding RTR)
+                    continue
                 if int(ident, 16) == cob_id:
                     out.append((float(parts[0].strip("()")), bytes.fromhex(data)))
         return out

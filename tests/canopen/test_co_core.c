@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "co_emcy.h"
+#include "co_guard.h"
 #include "co_hb.h"
 #include "co_nmt.h"
 #include "co_pdo.h"
@@ -404,6 +405,53 @@ START_TEST(hb_states_and_timing)
 }
 END_TEST
 
+/* ---- node guarding (CiA 301 7.2.8.3.2.1) --------------------------------- */
+
+START_TEST(guard_rtr_toggle_and_life_time)
+{
+    co_guard g;
+    co_frame f, r;
+    int rtr;
+    co_guard_init(&g, 9, 100 * CO_MS, 3);
+    ck_assert_int_eq(co_guard_tick(&g, T0, &r, &rtr), CO_GUARD_NONE);
+    ck_assert_int_eq(rtr, 0);                                 /* not started */
+    co_guard_start(&g, T0);
+    co_guard_tick(&g, T0, &r, &rtr);
+    ck_assert_int_eq(rtr, 1);                                 /* RTR on 0x709 at once */
+    ck_assert_uint_eq(r.id, 0x709);
+    ck_assert_uint_eq(r.rtr, 1);
+    co_guard_tick(&g, T0 + 99 * CO_MS, &r, &rtr);
+    ck_assert_int_eq(rtr, 0);
+    co_guard_tick(&g, T0 + 100 * CO_MS, &r, &rtr);           /* every guard time */
+    ck_assert_int_eq(rtr, 1);
+    f = FR(0x709, 0x05);                                      /* operational, toggle 0 */
+    ck_assert_int_eq(co_guard_rx(&g, &f, T0 + 101 * CO_MS), CO_GUARD_STATE);
+    ck_assert_int_eq(co_guard_rx(&g, &f, T0 + 102 * CO_MS), CO_GUARD_TOGGLE);   /* toggle 0 again */
+    ck_assert_uint_eq(g.toggle_errors, 1);
+    f = FR(0x709, 0x85);                                      /* toggle 1: good */
+    ck_assert_int_eq(co_guard_rx(&g, &f, T0 + 200 * CO_MS), CO_GUARD_NONE);
+    f = FR(0x709, 0x00);                                      /* a boot-up is no answer */
+    ck_assert_int_eq(co_guard_rx(&g, &f, T0 + 210 * CO_MS), CO_GUARD_NONE);
+    f = FR(0x70A, 0x05);                                      /* another node */
+    ck_assert_int_eq(co_guard_rx(&g, &f, T0 + 220 * CO_MS), CO_GUARD_NONE);
+    /* last good answer at 200 ms: lost after 100 x 3 = 300 ms, not at 300 exactly */
+    ck_assert_int_eq(co_guard_tick(&g, T0 + 500 * CO_MS, &r, &rtr), CO_GUARD_NONE);
+    ck_assert_int_eq(co_guard_tick(&g, T0 + 501 * CO_MS, &r, &rtr), CO_GUARD_LOST);
+    ck_assert_int_eq(co_guard_tick(&g, T0 + 600 * CO_MS, &r, &rtr), CO_GUARD_NONE);   /* once */
+    ck_assert_int_eq(rtr, 1);                                 /* RTRs go on while lost */
+    ck_assert_uint_eq(g.losses, 1);
+    f = FR(0x709, 0x05);                                      /* toggle 0 expected now */
+    ck_assert_int_eq(co_guard_rx(&g, &f, T0 + 650 * CO_MS), CO_GUARD_BACK);
+    /* a late tick gives one RTR, not a burst */
+    int n = 0;
+    co_guard_tick(&g, T0 + 2000 * CO_MS, &r, &rtr);
+    n += rtr;
+    co_guard_tick(&g, T0 + 2001 * CO_MS, &r, &rtr);
+    n += rtr;
+    ck_assert_int_eq(n, 1);
+}
+END_TEST
+
 /* ---- EMCY ---------------------------------------------------------------- */
 
 START_TEST(emcy_decode)
@@ -456,6 +504,7 @@ Suite *core_suite(void)
     tcase_add_test(t, sdo_server_abort);
     tcase_add_test(t, sdo_timeout);
     tcase_add_test(t, hb_states_and_timing);
+    tcase_add_test(t, guard_rtr_toggle_and_life_time);
     tcase_add_test(t, emcy_decode);
     suite_add_tcase(s, t);
     return s;

@@ -24,6 +24,8 @@ typedef struct {
     entry od[160];
     int n;
     int started, resets, silent;
+    int guarded;            /* answers node guarding RTRs */
+    uint8_t toggle;
 } fake;
 
 static entry *od(fake *f, uint16_t index, uint8_t sub)
@@ -51,6 +53,13 @@ static int serve(fake *fk, const co_frame *in, co_frame *r)
 {
     if (fk->silent)
         return 0;
+    if (in->rtr && in->id == 0x700u + fk->id && fk->guarded) {
+        *r = frame(0x700u + fk->id, 1, (uint8_t[]){ (uint8_t)(0x05 | fk->toggle) });
+        fk->toggle ^= 0x80;
+        return 1;
+    }
+    if (in->id == 0 && (in->data[0] == 0x82 || in->data[0] == 0x81))
+        fk->toggle = 0;
     if (in->id == 0 && (in->data[1] == fk->id || in->data[1] == 0)) {
         if (in->data[0] == 0x82 || in->data[0] == 0x81) {
             fk->resets++;
@@ -269,6 +278,11 @@ START_TEST(process_data_and_sync)
     co_master_rx(&m, &t, T0);
     ck_assert_str_eq(logbuf, "");
     ck_assert_uint_eq(n[0].short_pdos, 2);
+    /* the node's status says its inputs are stale (bit 6) until a good one */
+    ck_assert(n[0].fault & CO_F_SHORT);
+    t = frame(0x181, 8, (uint8_t[]){ 1, 2, 3, 4, 5, 6, 7, 8 });
+    co_master_rx(&m, &t, T0);
+    ck_assert(!(n[0].fault & CO_F_SHORT));
 }
 END_TEST
 
@@ -318,6 +332,61 @@ START_TEST(heartbeat_lost_outputs_safe_then_restart)
     ck_assert_int_eq(n[1].phase, CO_PH_RUN);
     ck_assert(!(n[1].fault & CO_F_LOST));
     ck_assert_uint_eq(n[1].hb_lost, 1);
+}
+END_TEST
+
+START_TEST(guarding_lost_outputs_safe_then_restart)
+{
+    co_master m;
+    co_node n[1];
+    fake fk = { .id = 3, .device_type = 0x191, .guarded = 1 };
+    logbuf[0] = 0;
+    co_node_cfg_cia401(&n[0].cfg, 3);
+    n[0].cfg.hb_producer_ms = 0;
+    n[0].cfg.hb_consumer_ms = 0;
+    n[0].cfg.guard_ms = 100;
+    boot(&m, n, 1, &fk, 1);
+    ck_assert_int_eq(n[0].phase, CO_PH_RUN);
+    ck_assert_uint_eq(val(&fk, 0x100C, 0), 100);      /* the node guards us likewise */
+    ck_assert_uint_eq(val(&fk, 0x100D, 0), 3);
+    co_time t = T0;
+    for (; t < T0 + 1000 * CO_MS; t += 10 * CO_MS) {   /* answering: never lost */
+        co_master_tick(&m, t);
+        pump(&m, &fk, 1, t, NULL, 0);
+    }
+    ck_assert_int_eq(n[0].phase, CO_PH_RUN);
+    ck_assert_uint_eq(n[0].guard.answers, 10);         /* one RTR per 100 ms */
+    ck_assert_uint_eq(n[0].guard.toggle_errors, 0);
+    /* silent from t: the last answer came at t - 10 ms; lost after 300 ms */
+    co_time last = n[0].guard.last;
+    fk.guarded = 0;
+    for (; t <= last + 300 * CO_MS; t += 10 * CO_MS) {
+        co_master_tick(&m, t);
+        pump(&m, &fk, 1, t, NULL, 0);
+        ck_assert_int_eq(n[0].phase, CO_PH_RUN);
+    }
+    co_master_tick(&m, last + 301 * CO_MS);
+    ck_assert_int_eq(n[0].phase, CO_PH_LOST);
+    ck_assert(n[0].fault & CO_F_LOST);
+    ck_assert_ptr_nonnull(strstr(logbuf, "node 3: no answer to node guarding for 300 ms "
+                                         "(guard time 100 ms x life factor 3)"));
+    n[0].tx[0][0] = 0xFF;
+    co_master_cycle(&m, t);
+    co_frame seen[4];
+    pump(&m, &fk, 1, t, seen, 4);
+    ck_assert_uint_eq(seen[0].id, 0x203);
+    ck_assert_uint_eq(seen[0].data[0], 0x00);          /* outputs safe */
+    /* it answers again, its toggle bit where it left off: one answer may be
+     * refused for its toggle, the next is good; then it is reset */
+    int resets = fk.resets;
+    fk.guarded = 1;
+    for (int i = 0; i < 40 && n[0].phase != CO_PH_RUN; i++, t += 10 * CO_MS) {
+        co_master_tick(&m, t);
+        pump(&m, &fk, 1, t, NULL, 0);
+    }
+    ck_assert_int_eq(n[0].phase, CO_PH_RUN);
+    ck_assert_int_eq(fk.resets, resets + 1);
+    ck_assert_ptr_nonnull(strstr(logbuf, "node 3: answers node guarding again"));
 }
 END_TEST
 
@@ -388,6 +457,7 @@ Suite *master_suite(void)
     tcase_add_test(t, sdo_abort_during_config_reported);
     tcase_add_test(t, process_data_and_sync);
     tcase_add_test(t, heartbeat_lost_outputs_safe_then_restart);
+    tcase_add_test(t, guarding_lost_outputs_safe_then_restart);
     tcase_add_test(t, unexpected_bootup_reconfigures);
     tcase_add_test(t, emcy_logged_and_flagged);
     suite_add_tcase(s, t);

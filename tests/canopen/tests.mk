@@ -20,3 +20,37 @@ canopen_axis: $(BUILD)/plc/canopen_axis/plcrt | bus-backend
 TESTS += canopen_axis
 STRESS_TESTS += canopen_axis
 endif
+
+# the simulated CiA 402 drive against the standard's table and python-canopen's
+# BaseNode402, then plcrt driving two of them with CIA402DRIVE (examples/cia402)
+.PHONY: canopen_drive402 canopen_cia402
+canopen_drive402: | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_drive402 $(BUS_RUN) $(CO_BUILD)/uml_drive402 \
+	  @PY@ tests/canopen/drive402_test.py $(CO_BUILD)/uml_drive402
+TESTS += canopen_drive402
+canopen_cia402: $(BUILD)/plc/cia402/plcrt | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_cia402 $(BUS_RUN) $(CO_BUILD)/uml_cia402 \
+	  @PY@ tests/canopen/plcrt_cia402_test.py $(BUILD)/plc/cia402/plcrt $(CO_BUILD)/uml_cia402
+TESTS += canopen_cia402
+
+# seed 000's DRIVETYPE 91: an APOSS axis on the analog output of a guarded CiA 401 module
+ifneq ($(ST_LIB),)
+$(eval $(call plcrt_program,canopen_aposs,$(ST_LIB) tests/canopen/st/canopen_aposs.st))
+.PHONY: canopen_drivetype
+canopen_drivetype: $(BUILD)/plc/canopen_aposs/plcrt | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_drivetype $(BUS_RUN) $(CO_BUILD)/uml_drivetype \
+	  @PY@ tests/canopen/plcrt_drivetype_test.py $(BUILD)/plc/canopen_aposs/plcrt $(CO_BUILD)/uml_drivetype
+TESTS += canopen_drivetype
+endif
+
+# the EDS/DCF reader (CiA 306), under the sanitizers: it reads vendors' files
+$(CO_BUILD)/eds_test: tests/canopen/eds_test.c $(CO_DIR)/eds.c $(CO_SRC) $(CO_HDR)
+	@mkdir -p $(@D)
+	$(call say,LD,$@)
+	$(Q)$(CC) $(CFLAGS) $(SAN) -I$(CO_DIR) tests/canopen/eds_test.c $(CO_DIR)/eds.c $(CO_SRC) -o $@ \
+	    -linih $$(pkg-config --cflags --libs check)
+.PHONY: canopen_eds
+canopen_eds: $(CO_BUILD)/eds_test
+	@mkdir -p $(CO_BUILD)/eds_files
+	@mk/suite.sh $(RESULTS) canopen_eds $< $(CO_BUILD)/eds_files
+TESTS += canopen_eds

@@ -1,0 +1,171 @@
+"""Seed 000's DRIVETYPE 91 on a real bus (vcan0 inside a kernel with CAN,
+tests/canopen/bus_run.sh): plcrt runs st/canopen_aposs.st, an APOSSAXIS
+whose speed reference goes to analog output 1 of CiA 401 node 4
+(slave401.Axis, which integrates it into the encoder count it sends back).
+The node answers node guarding (RTR on 0x704, toggle bit); then it stops
+answering during a move: error 88, the loop open and every reference on the
+bus 0 from the first cycle past guard time x life factor (kernel timestamps
+of the recorded frames); ERRCLR while it is silent raises 88 again; a
+negative DRIVETYPE lets ERRCLR stand (the seed's way out); answering again,
+the node is restarted and the axis moves.
+
+    $PY tests/canopen/plcrt_drivetype_test.py PLCRT OUT_DIR
+"""
+import os
+import signal
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from slave401 import Axis, CanDump, connect  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from peer import Report, wait_for  # noqa: E402
+from pymodbus.client import ModbusTcpClient  # noqa: E402
+
+plcrt, out = sys.argv[1], sys.argv[2]
+PORT = 15035
+GUARD, LIFE, CYCLE = 0.100, 3, 0.010
+report = Report("canopen_drivetype")
+
+cfg = os.path.join(out, "drivetype.ini")
+with open(cfg, "w") as f:
+    f.write(f"""[plc]
+log_level = info
+[io]
+backend = canopen
+[modbus]
+port = {PORT}
+[canopen]
+interface = vcan0
+cansynctimer_ms = 10
+[canopen.module4]
+id = 4
+device_type = 0x191
+drivetype = 91
+rpdo1 = 0x6411:01:16 0x6411:02:16 0x6411:03:16 0x6411:04:16
+tpdo1 = 0x2000:00:32
+bind = 0x6411:01 %QW0
+bind = 0x6411:02 %QW1
+bind = 0x6411:03 %QW2
+bind = 0x6411:04 %QW3
+bind = 0x2000:00 %ID0
+status = %IW30
+""")
+
+trace = CanDump(os.path.join(out, "candump.log"))
+net = connect("vcan0")
+axis = Axis(net, 4, maxvel=40000.0)
+log = open(os.path.join(out, "plcrt.log"), "w")
+plc = subprocess.Popen([plcrt, "-c", cfg], stdout=log, stderr=subprocess.STDOUT)
+mb = ModbusTcpClient("127.0.0.1", port=PORT)
+ok = wait_for(lambda: mb.connect(), 10) and wait_for(lambda: axis.state == 5, 5)
+seq = [0]
+
+
+def mw(a, n=1):
+    rr = mb.read_holding_registers(1024 + a, n, slave=1)
+    return None if rr.isError() else rr.registers
+
+
+def md(a):
+    rr = mb.read_holding_registers(2048 + 2 * a, 2, slave=1)
+    if rr.isError():
+        return None
+    v = rr.registers[0] << 16 | rr.registers[1]
+    return v - (1 << 32) if v & 0x80000000 else v
+
+
+def put_md(a, v):
+    v &= 0xFFFFFFFF
+    mb.write_registers(2048 + 2 * a, [v >> 16, v & 0xFFFF], slave=1)
+
+
+def command(c, pos=None):
+    if pos is not None:
+        put_md(1, pos)
+    seq[0] += 1
+    mb.write_registers(1024, [c, seq[0]], slave=1)
+
+
+def bits():
+    r = mw(3)
+    return r[0] if r else 0
+
+
+def errnum():
+    r = mw(2)
+    return r[0] if r else None
+
+
+MOTOR, BUSY, INPOS, ERROR, BUSERR = 1, 2, 4, 8, 16
+rtr0 = axis.guard_rtrs
+time.sleep(0.5)
+report("guarded_not_heartbeat", ok and axis.get(0x100C) == 100 and axis.get(0x100D) == 3
+       and axis.guard_rtrs - rtr0 >= 3 and axis.get(0x1017) == 0,
+       f"0x100C {axis.get(0x100C)} ms, 0x100D {axis.get(0x100D)}, {axis.guard_rtrs - rtr0} RTRs in 0.5 s")
+command(1)
+wait_for(lambda: bits() & MOTOR, 5)
+command(4, 20000)
+ok = wait_for(lambda: bits() & INPOS and not bits() & BUSY, 15)
+count = axis.get(0x2000)
+report("moves_by_analog_output_1", ok and abs(count - 20000) <= 50 and errnum() == 0,
+       f"encoder {count}, ERRNUM {errnum()}")
+
+# a long move, and the node falls silent in the middle of it
+command(4, -200000)
+wait_for(lambda: abs(axis.get(0x6411, 1)) > 3000, 5)
+axis.guard_answer = False
+ok = wait_for(lambda: errnum() == 88, 5)
+b = bits()
+report("silent_node_error_88_loop_open", ok and not b & MOTOR and b & BUSERR, f"ERRNUM {errnum()}, bits {b}")
+n88 = md(3)
+command(3)                                          # ERRCLR while still silent
+ok = wait_for(lambda: md(3) == n88 + 1, 5)
+report("errclr_while_silent_raises_88_again", ok and errnum() == 88, f"errors 88: {n88} -> {md(3)}")
+put_md(0, -91)                                      # the seed's way out: no guarding
+command(3)
+time.sleep(0.3)
+report("negative_drivetype_errclr_stands", errnum() == 0 and not bits() & ERROR, f"ERRNUM {errnum()}")
+put_md(0, 91)
+time.sleep(0.1)
+report("positive_again_88_again", wait_for(lambda: errnum() == 88, 5), f"ERRNUM {errnum()}")
+
+axis.guard_answer = True
+ok = wait_for(lambda: not bits() & BUSERR, 10)
+command(3)
+ok = ok and wait_for(lambda: errnum() == 0, 5)
+time.sleep(0.2)
+report("answers_again_errclr_clears", ok and errnum() == 0, f"ERRNUM {errnum()}, bits {bits()}")
+command(1)
+wait_for(lambda: bits() & MOTOR, 5)
+here = axis.get(0x2000)
+command(4, here + 10000)
+ok = wait_for(lambda: bits() & INPOS and not bits() & BUSY, 15)
+report("moves_again", ok and abs(axis.get(0x2000) - (here + 10000)) <= 50, f"encoder {axis.get(0x2000)}")
+plc.send_signal(signal.SIGTERM)
+report("plcrt_exits_0", plc.wait(10) == 0)
+
+# ---- on the bus: the last good answer, then the RPDOs ----
+answers = [t for t, d in trace.frames(0x704) if d and d[0] & 0x7F == 0x05]
+rpdo = trace.frames(0x204)
+# the first silence: the last answer before the first gap longer than the life time
+t_last = next((a for a, b in zip(answers, answers[1:]) if b - a > GUARD * LIFE), None)
+if t_last is None:
+    report("reference_zero_past_life_time", False, "no gap in the guarding answers recorded")
+else:
+    deadline = t_last + GUARD * LIFE
+    nxt = min([a for a in answers if a > t_last], default=float("inf"))
+    after = [(t, d) for t, d in rpdo if deadline + 2 * CYCLE <= t < nxt]
+    moving = [t for t, d in rpdo if t_last - 0.2 < t < t_last and int.from_bytes(d[:2], "little", signed=True)]
+    bad = [round((t - t_last) * 1000) for t, d in after if any(d)]
+    first0 = min([t for t, d in rpdo if t > t_last and not any(d)], default=None)
+    others = [d for t, d in rpdo if any(d[2:8])]
+    report("reference_zero_past_life_time", after and not bad and moving,
+           (f"first zero RPDO {(first0 - t_last) * 1000:.0f} ms after the last answer "
+            f"(guard {GUARD * 1000:.0f} ms x life {LIFE} + one cycle {CYCLE * 1000:.0f} ms); "
+            + (f"non-zero at {bad[:5]} ms" if bad else f"{len(after)} RPDOs after, all 0"))
+           if first0 else "no zero RPDO")
+    report("outputs_2_to_4_stay_0", rpdo and not others, f"{len(others)} RPDOs with outputs 2..4 not 0")
+trace.close(keep=not report.all_passed())
+sys.exit(0 if report.all_passed() else 1)
