@@ -28,10 +28,12 @@ canopen_drive402: | bus-backend
 	@mk/suite.sh $(RESULTS) canopen_drive402 $(BUS_RUN) $(CO_BUILD)/uml_drive402 \
 	  @PY@ tests/canopen/drive402_test.py $(CO_BUILD)/uml_drive402
 TESTS += canopen_drive402
+STRESS_TESTS += canopen_drive402
 canopen_cia402: $(BUILD)/plc/cia402/plcrt | bus-backend
 	@mk/suite.sh $(RESULTS) canopen_cia402 $(BUS_RUN) $(CO_BUILD)/uml_cia402 \
 	  @PY@ tests/canopen/plcrt_cia402_test.py $(BUILD)/plc/cia402/plcrt $(CO_BUILD)/uml_cia402
 TESTS += canopen_cia402
+STRESS_TESTS += canopen_cia402
 
 # seed 000's DRIVETYPE 91: an APOSS axis on the analog output of a guarded CiA 401 module
 ifneq ($(ST_LIB),)
@@ -41,6 +43,7 @@ canopen_drivetype: $(BUILD)/plc/canopen_aposs/plcrt | bus-backend
 	@mk/suite.sh $(RESULTS) canopen_drivetype $(BUS_RUN) $(CO_BUILD)/uml_drivetype \
 	  @PY@ tests/canopen/plcrt_drivetype_test.py $(BUILD)/plc/canopen_aposs/plcrt $(CO_BUILD)/uml_drivetype
 TESTS += canopen_drivetype
+STRESS_TESTS += canopen_drivetype
 endif
 
 # the EDS/DCF reader (CiA 306), under the sanitizers: it reads vendors' files
