@@ -13,6 +13,7 @@
 
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Elementary types as the generated code declares them (same widths). */
@@ -85,6 +86,35 @@ static inline void tick_clock(void)
     unsigned long long ns = (unsigned long long)__CURRENT_TIME.tv_nsec + common_ticktime__;
     __CURRENT_TIME.tv_sec += (long)(ns / 1000000000ULL);
     __CURRENT_TIME.tv_nsec = (long)(ns % 1000000000ULL);
+}
+
+/* A figures program's whole main: run `prog ticks` ticks of the program,
+   then print %QD0..%QD(n-1) on one line as "label value" pairs. Status 2
+   with a usage line when ticks is missing or the program lacks one. */
+static inline int run_print_qd(int argc, char **argv, const char *const *label, int n)
+{
+    long ticks = argc == 2 ? atol(argv[1]) : 0;
+    int32_t *q[64];
+    for (int i = 0; i < n && i < 64; i++) {
+        char name[8];
+        snprintf(name, sizeof name, "%%QD%d", i);
+        q[i] = located(name, NULL);
+        if (!q[i])
+            ticks = 0;
+    }
+    if (ticks < 1 || n > 64) {
+        fprintf(stderr, "usage: %s ticks (program with %%QD0..%%QD%d)\n", argv[0], n - 1);
+        return 2;
+    }
+    config_init__();
+    for (long i = 0; i < ticks; i++) {
+        config_run__((unsigned long)i);
+        tick_clock();
+    }
+    for (int i = 0; i < n; i++)
+        printf("%s%s %ld", i ? " " : "", label[i], (long)*q[i]);
+    printf("\n");
+    return 0;
 }
 
 #endif
