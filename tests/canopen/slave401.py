@@ -151,7 +151,14 @@ class Slave401:
         states = {0x01: 5, 0x02: 4, 0x80: 127}
         if cmd in states:
             self.node.nmt._state = states[cmd]
-            self.node.nmt.update_heartbeat()
+            # a new periodic task with the new state, not an update of the
+            # running one: on a loaded host the kernel's modified task was
+            # seen to send once and then stop (node silent, "lost")
+            hb = self.get(0x1017)
+            if hb:
+                self.node.nmt.start_heartbeat(hb)
+            else:
+                self.node.nmt.update_heartbeat()
 
     def stop_heartbeat(self):
         self.node.nmt.stop_heartbeat()
