@@ -442,13 +442,16 @@ class Link:
         return tags
 
     def tags_state(self):
+        shown = os.path.relpath(self.tags_path) if self.tags_path else None
+        if shown and shown.startswith(".."):
+            shown = self.tags_path
         if not self.tags_path:
             return "none (writes are forced: plcweb --tags build/gen/TAGS.json writes through Modbus)"
         tags = self.tag_list()
         if not self.tags_key:
-            return f"{self.tags_path}: not found (writes are forced)"
+            return f"{shown}: not found (writes are forced)"
         skipped = getattr(self, "tags_skipped", 0)
-        return (f"{len(tags)} tags from {self.tags_path}"
+        return (f"{len(tags)} tags from {shown}"
                 + (f" ({skipped} not in the running program: left out)" if skipped else ""))
 
     def tag_of(self, v):
@@ -718,6 +721,8 @@ def decode_backend(kind, names, r):
                          "rounds": rounds, "timeouts": u32(r, b + 2), "exceptions": u32(r, b + 4),
                          "bad frames": u32(r, b + 6), "reconnects": lost,
                          "round (ms)": round(u32(r, b + 12) / 1000, 1)})
-        return {"kind": kind, "summary": f"{r[1]} of {r[0]} devices ok, {u32(r, 2)} faults since the start",
+        n = u32(r, 2)
+        return {"kind": kind, "summary": f"{r[1]} of {r[0]} devices ok, {n} fault{'' if n == 1 else 's'} "
+                                         "since the start",
                 "rows": rows}
     return {"kind": kind, "summary": "", "rows": []}

@@ -99,7 +99,7 @@ async function overview() {
           for (const c of cols) {
             const cell = r.insertCell();
             cell.textContent = row[c];
-            cell.className = c;
+            cell.className = c.replace(/\W+/g, "-");
             if (c === "state") cell.classList.add(row.state === "ok" || row.state === "operational" ? "good" : "bad");
           }
         }

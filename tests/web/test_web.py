@@ -658,6 +658,7 @@ def tags_and_backends(drv, plcrt, ini_src, users, work, shots):
         report("overview: remote I/O devices rack and panel by their names, both ok, '2 of 2 devices ok' as plcrt "
                "counts (input registers 21000-21001)", both and regs == [2, 2] and "2 of 2 devices ok" in head,
                f"{head} {regs}")
+        drv.execute_script("document.getElementById('ov-backends').scrollIntoView()")
         drv.save_screenshot(os.path.join(shots, "web-backends.png"))
         peers.stop(rack)
         lost = wait_for(lambda: state("rack") == "lost" and state("panel") == "ok", 15, 0.1)
@@ -666,6 +667,10 @@ def tags_and_backends(drv, plcrt, ini_src, users, work, shots):
         report("the rack's server killed: the page shows rack lost, panel ok, a fault counted, as plcrt's "
                "registers say (1 of 2 ok)", lost and regs[1] == 1 and (regs[2] << 16 | regs[3]) >= 1
                and "1 of 2 devices ok" in head, f"{head} {regs}")
+        report("the tag list is named on the overview by its path from plcweb's folder, no folder above it",
+               "tags from " + os.path.relpath(os.path.join(proj, "build", "gen", "TAGS.json")) in text(drv, "ov-tags"),
+               text(drv, "ov-tags"))
+        drv.execute_script("document.getElementById('ov-backends').scrollIntoView()")
         drv.save_screenshot(os.path.join(shots, "web-backends-lost.png"))
     finally:
         web.terminate()
