@@ -669,7 +669,8 @@ def read_backends(path):
     try:
         lines = open(path).read().splitlines()
     except (OSError, UnicodeDecodeError) as e:
-        raise SystemExit(f"plcweb: --config {path}: cannot read it: {e}")
+        raise SystemExit(f"plcweb: --config {path}: cannot read it ({getattr(e, 'strerror', None) or e}): "
+                         "give plcrt's configuration file, e.g. --config plcrt.ini")
     section, kinds, sections = "", ["sim"], []
     for line in lines:
         s = line.split(";")[0].split("#")[0].strip()

@@ -643,6 +643,22 @@ def tags_and_backends(drv, plcrt, ini_src, users, work, shots):
                "sent through cSTOP's tag", stopped and mb.md(POSIT) < p0 + 15000
                and "coil 20" in text(drv, "message"), f"{p0} -> {mb.md(POSIT)} {text(drv, 'message')}")
 
+        # ---- a tag list that does not fit the running program is not used ----
+        tj = os.path.join(proj, "build", "gen", "TAGS.json")
+        good = open(tj).read()
+        d = json.loads(good)
+        for t in d["tags"]:
+            if t["name"] == "CONFIG0.RES0.AXIS.SLVELASSE":
+                t["type"] = "INT"           # as in another program
+        open(tj, "w").write(json.dumps(d))
+        h = Http(wport)
+        h.login("olga", "olga-secret-1")
+        st, body = h.req("POST", "/api/write", {"path": "slvelasse", "value": "55"})
+        report("a tag list whose slVelAsse is of another type: not written there; refused in words, as forcing "
+               "is off (pymodbus still reads 41)", st == 409 and b"no Modbus tag" in body and b"allow_force" in body
+               and mb.md(SPEED) == 41, f"{st} {body[:300]} {mb.md(SPEED)}")
+        open(tj, "w").write(good)
+
         # ---- the I/O backends: the remote I/O devices in words ----
         drv.get(f"http://127.0.0.1:{wport}/overview")
         wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 10, 0.05)
