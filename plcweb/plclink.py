@@ -15,6 +15,7 @@ protocol code is plctrace's own (plc_runtime/plctrace), imported, not copied.
 import importlib.machinery
 import logging
 import importlib.util
+import json
 import os
 import shutil
 import socket
@@ -79,8 +80,11 @@ class Link:
     """One Modbus connection to plcrt, shared by plcweb's threads under a lock,
     and the watcher that samples watched variables."""
 
-    def __init__(self, host, port, rate=20.0):
+    def __init__(self, host, port, rate=20.0, tags=None, config=None):
         self.host, self.port, self.rate = host, port, rate
+        self.tags_path, self.tags, self.tags_key = tags, {}, None
+        self.config = config
+        self.backends_cfg = read_backends(config) if config else None
         self.lock = threading.RLock()       # the connection
         self.trace_lock = threading.Lock()  # plcweb's own use of the trace
         self.p = None
@@ -148,7 +152,14 @@ class Link:
                 raise Refused(f"diagnostics: exception {getattr(r, 'exception_code', None)}: {r}")
             b = p.c.read_input_registers(1088, 64, slave=1)
             return r.registers, (b.registers if not b.isError() else []), p.status()
+        def read_blocks(p):
+            out = []
+            for k in range(len(self.backends_cfg or [])):
+                r = p.c.read_input_registers(20000 + 1000 * k, 120, slave=1)
+                out.append(r.registers if not r.isError() else None)
+            return out
         regs, backend, st = self.call(read)
+        blocks = self.call(read_blocks)
         d = {k: u32(regs, o) for k, o in DIAG_NAMES.items()}
         d["overruns_late"] = d["overruns"] - d["overruns_own"]
         d["period_ns"] = st["period_ns"]
@@ -162,6 +173,10 @@ class Link:
             spd = struct.unpack(">i", struct.pack(">I", u32(backend, k + 2)))[0]
             axes.append({"axis": k // 4, "position": pos, "speed": spd})
         d["backend"] = axes
+        d["backends"] = [decode_backend(kind, names, regs) for (kind, names), regs in
+                         zip(self.backends_cfg or [], blocks)]
+        d["backends_known"] = self.backends_cfg is not None
+        d["tags"] = self.tags_state()
         self.table()
         d["programs"] = sorted({".".join(v["path"].split(".")[:3]) for v in self.vars if v["path"].count(".") >= 2})
         d["watch_state"] = self.watch_state
@@ -384,36 +399,116 @@ class Link:
         r = self.call(lambda p: p.c.read_input_registers(DIAG, 50, slave=1))
         return u32(r.registers, 0), u32(r.registers, 48)
 
+    # ---- the tag list: writes as an HMI makes them ----
+    def tag_list(self):
+        """{IEC path upper: tag} of the tag list (TAGS.json, or TAGS.csv),
+        read again when the file changes; tags whose variable the running
+        program lacks, or has with another type, are left out (a list of
+        another program must never write to its addresses)."""
+        if not self.tags_path:
+            return {}
+        path = self.tags_path
+        if os.path.isdir(path):
+            path = os.path.join(path, "TAGS.json")
+        try:
+            st = os.stat(path)
+            key = (path, st.st_mtime_ns, st.st_size, self.generation)
+        except OSError:
+            self.tags, self.tags_key = {}, None
+            return {}
+        if key == self.tags_key:
+            return self.tags
+        try:
+            if path.endswith(".csv"):
+                import csv
+                with open(path, newline="") as f:
+                    raw = [dict(r, address=int(r["address"]), registers=int(r["registers"]))
+                           for r in csv.DictReader(f)]
+            else:
+                with open(path) as f:
+                    raw = json.load(f)["tags"]
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            log.warning("tag list %s: not read (%s): writes are forced", path, e)
+            self.tags, self.tags_key = {}, key
+            return {}
+        self.table()
+        tags = {}
+        for t in raw:
+            v = self.by_path.get(str(t.get("name", "")).upper())
+            if v and v["type"].upper() == str(t.get("type", "")).upper():
+                tags[v["path"].upper()] = t
+        self.tags, self.tags_key = tags, (path, st.st_mtime_ns, st.st_size, self.generation)
+        self.tags_skipped = len(raw) - len(tags)
+        return tags
+
+    def tags_state(self):
+        shown = os.path.relpath(self.tags_path) if self.tags_path else None
+        if shown and shown.startswith(".."):
+            shown = self.tags_path
+        if not self.tags_path:
+            return "none (writes are forced: plcweb --tags build/gen/TAGS.json writes through Modbus)"
+        tags = self.tag_list()
+        if not self.tags_key:
+            return f"{shown}: not found (writes are forced)"
+        skipped = getattr(self, "tags_skipped", 0)
+        return (f"{len(tags)} tags from {shown}"
+                + (f" ({skipped} not in the running program: left out)" if skipped else ""))
+
+    def tag_of(self, v):
+        t = self.tag_list().get(v["path"].upper())
+        return t if t and t.get("access") == "read-write" and t.get("table") in ("coil", "holding") else None
+
+    def tag_write(self, t, value):
+        try:
+            self.call(lambda p: plctrace.tag_write(p, t, value))
+        except ValueError as e:
+            raise Refused(str(e)) from None
+
     def write(self, path, value):
-        """A one-shot write: forced for a few cycles, then released, so that
-        the program sees the value at least once and then takes the variable
-        back (what the program, the I/O or a client writes afterwards wins,
-        as after a Modbus write). Needs forcing allowed."""
+        """Write a value: through the variable's tag, an ordinary Modbus write
+        (then what the program, the I/O or a client writes afterwards wins);
+        without a tag, forced for a few cycles and released (needs forcing
+        allowed). Returns (path, how it was written, in words)."""
         v = self.resolve(path)
+        t = self.tag_of(v)
         if v["path"].upper() in {p.upper() for p, _, _ in self.forced_now()}:
             raise Refused(f"{v['path']} is forced: unforce it first, or force the new value")
+        if t:
+            self.tag_write(t, value)
+            return v["path"], f"Modbus write, {t['table']} {t['address']} (its tag)"
+        self.forced_write(v, value)
+        return v["path"], "forced for two cycles (no Modbus tag)"
+
+    def forced_write(self, v, value):
+        """A one-shot write: forced for a few cycles, then released, so that
+        the program sees the value at least once and then takes the variable
+        back. Needs forcing allowed."""
         c0, n0 = self.cycles_and_forced()
         try:
             self.force(v["path"], value)
         except Refused as e:
             if "exception 1" in str(e):
-                raise Refused(f"write {v['path']}: plcrt writes a program variable by forcing it for two cycles, "
-                              "and its configuration does not allow forcing: [debug] allow_force = yes") from None
+                why = ("it has no Modbus tag" if self.tags_path else "plcweb has no tag list (--tags)")
+                raise Refused(f"write {v['path']}: {why}, so plcweb writes it by forcing it for two cycles, "
+                              "and plcrt's configuration does not allow forcing: [debug] allow_force = yes "
+                              "(or map it in [modbus.symbols] with rw)") from None
             raise
         try:
             # the scan has taken the force when its count shows it; then two cycles more
-            end = time.monotonic() + 5
-            while time.monotonic() < end:
-                c, n = self.cycles_and_forced()
-                if n > n0:
-                    c1 = c
-                    while time.monotonic() < end and self.cycles_and_forced()[0] < c1 + 2:
-                        time.sleep(0.002)
-                    break
-                time.sleep(0.002)
+            self.wait_cycles(2, lambda: self.cycles_and_forced()[1] > n0)
         finally:
             self.unforce(v["path"])
-        return v["path"]
+
+    def wait_cycles(self, n, first=lambda: True):
+        """Until first() holds, then until n more cycles ran (5 s at most)."""
+        end = time.monotonic() + 5
+        while time.monotonic() < end:
+            if first():
+                c1 = self.cycles_and_forced()[0]
+                while time.monotonic() < end and self.cycles_and_forced()[0] < c1 + n:
+                    time.sleep(0.002)
+                return
+            time.sleep(0.002)
 
     # ---- axes ----
     def axes(self):
@@ -466,7 +561,18 @@ class Link:
         if not cmd:
             raise Refused(f"{ax['kind']} axis {path}: no {action} command here (the program's MC_Stop/MC_Reset)")
         try:
-            return self.write(cmd, "TRUE")
+            v = self.resolve(cmd)
+            t = self.tag_of(v)
+            if not t:
+                return self.write(cmd, "TRUE")
+            # through its tag: TRUE, two cycles, FALSE: a rising edge the program
+            # sees whether or not it clears the command itself
+            self.tag_write(t, "TRUE")
+            try:
+                self.wait_cycles(2)
+            finally:
+                self.tag_write(t, "FALSE")
+            return v["path"], f"Modbus write, {t['table']} {t['address']} (its tag), TRUE for two cycles"
         except Refused as e:
             raise Refused(f"{action} {ax['kind']} {path}: {e}") from None
 
@@ -552,3 +658,72 @@ class Link:
                     self.call(lambda p: p.command(plctrace.RELEASE, what="release"))
                 except Exception:
                     pass
+
+
+# ---- the I/O backends' diagnostics (docs/canopen.md, docs/remote-io.md) ----
+def read_backends(path):
+    """[(kind, [section names])] of plcrt's configuration, in the order of
+    [io] backend: the names of the canopen nodes and modbus_io devices in
+    file order (the order of their diagnostics). Read line by line: the
+    file repeats keys (read, write, bind) that configparser refuses."""
+    try:
+        lines = open(path).read().splitlines()
+    except (OSError, UnicodeDecodeError) as e:
+        raise SystemExit(f"plcweb: --config {path}: cannot read it ({getattr(e, 'strerror', None) or e}): "
+                         "give plcrt's configuration file, e.g. --config plcrt.ini")
+    section, kinds, sections = "", ["sim"], []
+    for line in lines:
+        s = line.split(";")[0].split("#")[0].strip()
+        if s.startswith("[") and s.endswith("]"):
+            section = s[1:-1].strip()
+            sections.append(section)
+        elif section == "io" and "=" in s and s.split("=")[0].strip() == "backend":
+            kinds = [k.strip() for k in s.split("=", 1)[1].split(",") if k.strip()]
+    out = []
+    for kind in kinds:
+        names = [x.split(".", 1)[1] for x in sections if x.startswith(kind + ".") and x.count(".") == 1] \
+            if kind in ("canopen", "modbus_io") else []
+        out.append((kind, names))
+    return out
+
+
+CO_PHASES = ["idle", "waiting for boot-up", "checking device type", "configuring", "operational", "lost", "failed"]
+CO_FAULTS = ["lost", "EMCY", "SDO error", "start-up failed", "wrong device type", "unexpected boot-up",
+             "short TPDO"]
+CO_BUS = ["ok", "error warning", "error passive", "bus-off", "interface down"]
+
+
+def decode_backend(kind, names, r):
+    """A backend's block in words: {kind, summary, rows: [{name, state, ...}]}."""
+    if r is None:
+        return {"kind": kind, "summary": "its registers do not answer", "rows": []}
+    if kind == "canopen":
+        rows = []
+        for k in range(min(r[2], 10)):
+            b = 4 + 6 * k
+            phase = r[b] >> 8
+            faults = [n for i, n in enumerate(CO_FAULTS) if r[b + 1] & (1 << i)]
+            rows.append({"name": names[k] if k < len(names) else f"node {k}", "id": r[b] & 0xFF,
+                         "state": CO_PHASES[phase] if phase < len(CO_PHASES) else f"phase {phase}",
+                         "faults": ", ".join(faults) or "none", "boot-ups": r[b + 2],
+                         "heartbeat losses": r[b + 3], "EMCYs": r[b + 4],
+                         "last EMCY": f"{r[b + 5]:04X}" if r[b + 4] else "-"})
+        bus = CO_BUS[r[0]] if r[0] < len(CO_BUS) else f"state {r[0]}"
+        return {"kind": kind, "summary": f"bus {bus}, {r[3]} of {r[2]} nodes operational, bus-off {r[1]} times",
+                "rows": rows}
+    if kind == "modbus_io":
+        rows = []
+        for k in range(min(r[0], 6)):
+            b = 16 + 16 * k
+            ok, lost = r[b + 10], u32(r, b + 8)
+            rounds = u32(r, b)
+            state = "ok" if ok else ("lost" if lost or u32(r, b + 2) or rounds else "not reached yet")
+            rows.append({"name": names[k] if k < len(names) else f"device {k}", "state": state,
+                         "rounds": rounds, "timeouts": u32(r, b + 2), "exceptions": u32(r, b + 4),
+                         "bad frames": u32(r, b + 6), "reconnects": lost,
+                         "round (ms)": round(u32(r, b + 12) / 1000, 1)})
+        n = u32(r, 2)
+        return {"kind": kind, "summary": f"{r[1]} of {r[0]} devices ok, {n} fault{'' if n == 1 else 's'} "
+                                         "since the start",
+                "rows": rows}
+    return {"kind": kind, "summary": "", "rows": []}

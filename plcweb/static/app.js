@@ -56,7 +56,7 @@ const OV = [
   ["Modbus clients", "clients"], ["requests served", "requests"], ["exceptions sent", "exceptions"],
   ["retain saves (failures)", ["retain_saves", "retain_failures"]], ["forced variables", "forced"],
   ["forcing allowed", "force_allowed"], ["I/O errors", "io_errors"], ["trace", "trace_state"],
-  ["variables", "nvars"], ["up (s)", "uptime_s"], ["watch", "watch_state"],
+  ["variables", "nvars"], ["up (s)", "uptime_s"], ["tag list (writes)", "tags"], ["watch", "watch_state"],
   ["variables watched, ms the trace is held per sample", ["watching", "watch_round_ms"]]];
 async function overview() {
   $("ov-plc").textContent = "plcrt at " + session.plc;
@@ -76,11 +76,44 @@ async function overview() {
     }
     const b = $("ov-backend");
     b.textContent = "";
-    const h = b.insertRow();
-    ["sim axis (registers 1088-1151)", "position (counts)", "speed (counts/s)"].forEach(x => h.appendChild(el("th", x)));
-    for (const a of d.backend.filter(a => a.axis === 0 || a.position || a.speed)) {
-      const r = b.insertRow();
-      [a.axis, a.position, a.speed].forEach(x => r.insertCell().textContent = x);
+    const kinds = d.backends_known ? d.backends.map(x => x.kind) : ["sim"];
+    const bx = $("ov-backends");
+    bx.textContent = "";
+    if (!d.backends_known)
+      bx.appendChild(el("p", "Which backends run is in plcrt's configuration: plcweb --config plcrt.ini names them " +
+                              "and shows the CANopen nodes and remote I/O devices."));
+    d.backends.forEach((k, i) => {
+      if (k.kind === "sim" || k.kind === "none") return;
+      const box = el("div", null, "backend");
+      box.id = "ov-backend-" + i;
+      box.dataset.kind = k.kind;
+      box.appendChild(el("h4", `${k.kind === "canopen" ? "CANopen" : "remote I/O (modbus_io)"}: ${k.summary}`));
+      if (k.rows.length) {
+        const t = el("table", null, "grid");
+        const cols = Object.keys(k.rows[0]);
+        const h = t.insertRow();
+        cols.forEach(c => h.appendChild(el("th", c)));
+        for (const row of k.rows) {
+          const r = t.insertRow();
+          r.dataset.name = row.name;
+          for (const c of cols) {
+            const cell = r.insertCell();
+            cell.textContent = row[c];
+            cell.className = c.replace(/\W+/g, "-");
+            if (c === "state") cell.classList.add(row.state === "ok" || row.state === "operational" ? "good" : "bad");
+          }
+        }
+        box.appendChild(t);
+      }
+      bx.appendChild(box);
+    });
+    if (kinds[0] === "sim") {
+      const h = b.insertRow();
+      ["sim axis (registers 1088-1151)", "position (counts)", "speed (counts/s)"].forEach(x => h.appendChild(el("th", x)));
+      for (const a of d.backend.filter(a => a.axis === 0 || a.position || a.speed)) {
+        const r = b.insertRow();
+        [a.axis, a.position, a.speed].forEach(x => r.insertCell().textContent = x);
+      }
     }
     say("");
   });
@@ -117,8 +150,8 @@ function drawWatch() {
       const b = el("button", label, "op " + label);
       b.onclick = async () => {
         try {
-          await api("POST", "/api/" + fn, {path: v.path, value: inp.value});
-          say(`${fn} ${v.path}${fn === "unforce" ? "" : " = " + inp.value}: done`, true);
+          const r = await api("POST", "/api/" + fn, {path: v.path, value: inp.value});
+          say(`${fn} ${v.path}${fn === "unforce" ? "" : " = " + inp.value}: done${r.how ? " (" + r.how + ")" : ""}`, true);
         } catch (e) { say(`${fn} ${v.path}: ${e.message}`); }
       };
       acts.appendChild(b);
@@ -217,7 +250,10 @@ async function axes() {
       if (!a.fields[act]) continue;
       const b = el("button", act === "stop" ? "Stop" : "Reset", "op " + act);
       b.onclick = async () => {
-        try { await api("POST", "/api/axis", {axis: a.path, action: act}); say(`${act} ${a.path}: sent`, true); }
+        try {
+          const r = await api("POST", "/api/axis", {axis: a.path, action: act});
+          say(`${act} ${a.path}: sent${r.how ? " (" + r.how + ")" : ""}`, true);
+        }
         catch (e) { say(`${act} ${a.path}: ${e.message}`); }
       };
       d.appendChild(b);

@@ -19,6 +19,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "common"))
 from peer import Report, free_port, wait_for  # noqa: E402
+from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 report = Report("web-make-run")
 
@@ -56,6 +57,27 @@ def main():
         d = json.loads(r.read())
         report("the printed login opens a session; the overview shows the EPICPOS example running",
                r.status == 200 and d.get("programs") == ["CONFIG0.RES0.AXIS"] and d.get("cycles", 0) > 0, d)
+        # the demo's tag list: a parameter written and Stop pressed through Modbus,
+        # with forcing not allowed (the example's configuration has no [debug])
+        c.request("GET", "/api/session", headers={"Cookie": cookie})
+        csrf = json.loads(c.getresponse().read())["csrf"]
+
+        def post(path, body):
+            c.request("POST", path, body=json.dumps(body), headers={
+                "Cookie": cookie, "X-CSRF-Token": csrf, "Content-Type": "application/json"})
+            r = c.getresponse()
+            return r.status, json.loads(r.read())
+        mb = ModbusTcpClient("127.0.0.1", port=port, timeout=3)
+        mb.connect()
+        st, w = post("/api/write", {"path": "slvelasse", "value": "37"})
+        r = mb.read_holding_registers(2050, 2, slave=1).registers
+        report("a parameter written from the page without forcing: slVelAsse 37 read back by pymodbus "
+               "(holding 2050), written through its tag", st == 200 and r == [0, 37]
+               and "Modbus write" in str(w.get("how")), f"{st} {w} {r}")
+        st, w = post("/api/axis", {"axis": "CONFIG0.RES0.AXIS.AXIS", "action": "stop"})
+        report("Stop pressed without forcing: sent through the tag of cSTOP (coil 20)",
+               st == 200 and "coil 20" in str(w.get("how")), f"{st} {w}")
+        mb.close()
         c.close()
         # plcrt itself (its command line starts with it), not the scripts that carry its arguments
         plcrt = subprocess.run(["pgrep", "-f", f"^[^ ]*plcrt -c {ini}"], capture_output=True, text=True).stdout.split()

@@ -117,7 +117,7 @@ def browser():
     return d
 
 
-def make_ini(src, dst, port, retain):
+def make_ini(src, dst, port, retain, force=True, backend=None, extra=""):
     out, section = [], ""
     for line in open(src).read().splitlines():
         s = line.strip()
@@ -128,8 +128,11 @@ def make_ini(src, dst, port, retain):
             line = f"port = {port}"
         elif section == "retain" and key == "file":
             line = f"file = {retain}"
+        elif section == "io" and key == "backend" and backend:
+            line = f"backend = {backend}"
         out.append(line)
-    out += ["", "[debug]", "allow_force = yes"]
+    out += ["", "[debug]", "allow_force = yes"] if force else []
+    out += [extra]
     open(dst, "w").write("\n".join(out) + "\n")
 
 
@@ -232,9 +235,14 @@ def main():
         plcrt_gone(wport, svc)
         if a.plcopen:
             plcopen_axes(drv, wport, port, a.plcopen, work, shots)
+        # last: its plcweb's session cookie replaces the first one's (cookies ignore the port)
+        tags_and_backends(drv, a.plcrt, a.ini, users, work, shots)
         log = open(os.path.join(work, "writes.log")).read()
         report("every write is logged with its user: olga's force, unforce, write and axis stop",
                all(f"olga: {w}" in log for w in ("force", "unforce", "write", "axis")), log[-800:])
+        log = open(os.path.join(work, "proj", "writes.log")).read()
+        report("a write through a tag is logged with its user and the way it went: olga's write and axis stop",
+               "Modbus write, holding 2050 (its tag)" in log and "Modbus write, coil 20 (its tag)" in log, log[-800:])
     finally:
         if drv:
             drv.quit()
@@ -571,6 +579,119 @@ def plcrt_gone(wport, svc):
     report("plcrt stopped: the overview and the watch list say plcrt does not answer; plcweb runs on",
            st == 502 and b"does not answer" in body and state and h.req("GET", "/api/session")[0] == 200,
            f"{st} {body[:200]} {vals[:200]}")
+
+
+def tags_and_backends(drv, plcrt, ini_src, users, work, shots):
+    """A plcrt with forcing off, as a project: plcrt.ini with the EPICPOS
+    example beside two remote I/O devices (pymodbus servers), and its tag
+    list in build/gen (plcrt --tags), which plcweb --config finds. A
+    parameter written and Stop pressed go through Modbus; the overview
+    names the devices and shows the one killed lost."""
+    sys.path.insert(0, os.path.join(HERE, "..", "remoteio"))
+    from iopeer import Peers
+    proj = os.path.join(work, "proj")
+    os.makedirs(os.path.join(proj, "build", "gen"), exist_ok=True)
+    port, rack_port, panel_port, wport = free_port(), free_port(), free_port(), free_port()
+    devs = "".join(f"[modbus_io.{n}]\nhost = 127.0.0.1\nport = {pt}\nperiod_ms = 20\ntimeout_ms = 100\n"
+                   f"reconnect_max_ms = 200\nok = %IX100.{k}\nread = discrete 0 8 %IX{101 + k}.0\n\n"
+                   for k, (n, pt) in enumerate((("rack", rack_port), ("panel", panel_port))))
+    ini = os.path.join(proj, "plcrt.ini")
+    make_ini(ini_src, ini, port, os.path.join(work, "proj.retain"), force=False, backend="sim, modbus_io",
+             extra=devs)
+    r = subprocess.run([plcrt, "-c", ini, "--tags", os.path.join(proj, "build", "gen")], capture_output=True,
+                       text=True)
+    report("plcrt --tags writes the tag list of the example beside two remote I/O devices",
+           r.returncode == 0 and os.path.exists(os.path.join(proj, "build", "gen", "TAGS.json")),
+           r.stdout + r.stderr)
+    peers = Peers()
+    rack, panel = peers.tcp(rack_port), peers.tcp(panel_port)
+    Plcrt(plcrt, ini, work, "proj")
+    mb = Mb(port)
+    web = subprocess.Popen([sys.executable, PLCWEB, "--users", users, "--port", str(wport), "--plc",
+                            f"127.0.0.1:{port}", "--config", ini, "--log", os.path.join(proj, "writes.log")],
+                           stdout=open(os.path.join(proj, "plcweb.log"), "w"), stderr=subprocess.STDOUT)
+    try:
+        wait_for(lambda: socket.socket().connect_ex(("127.0.0.1", wport)) == 0, 15, 0.1)
+        wait_for(lambda: mb.coil(C_LOOPON), 20, 0.05)
+        # ---- a parameter written with forcing off ----
+        login(drv, wport, "olga", "olga-secret-1", "/variables")
+        drv.execute_script("localStorage.setItem('plcweb.watch', JSON.stringify(arguments[0]))",
+                           [{"path": "CONFIG0.RES0.AXIS.SLVELASSE", "type": "DINT"}])
+        drv.refresh()
+        wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 10, 0.05)
+        row = drv.find_element(By.ID, "w-CONFIG0_RES0_AXIS_SLVELASSE")
+        row.find_element(By.CSS_SELECTOR, "input").send_keys("41")
+        row.find_element(By.CSS_SELECTOR, "button.write").click()
+        said = wait_for(lambda: "Modbus write" in text(drv, "message") and text(drv, "message"), 10, 0.05)
+        report("forcing off: write slVelAsse 41 from the page; pymodbus reads 41 (holding 2050), the page says "
+               "it went as a Modbus write of its tag, nothing forced", said and "holding 2050" in said
+               and wait_for(lambda: mb.md(SPEED) == 41, 5, 0.05) and mb.diag(FORCED) == 0,
+               f"{text(drv, 'message')} {mb.md(SPEED)}")
+        # ---- an axis stopped with forcing off ----
+        drv.get(f"http://127.0.0.1:{wport}/axes")
+        wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 10, 0.05)
+        wait_for(lambda: drv.find_elements(By.CSS_SELECTOR, ".axis button.stop"), 10, 0.05)
+        p0 = mb.md(POSIT)
+        mb.set_md(QUOTA, p0 + 20000)
+        mb.set_coil(C_START, True)
+        wait_for(lambda: not mb.coil(C_STILL), 5, 0.01)
+        mb.set_coil(C_START, False)
+        wait_for(lambda: mb.md(POSIT) > p0 + 500, 10, 0.02)
+        drv.find_element(By.CSS_SELECTOR, ".axis button.stop").click()
+        stopped = wait_for(lambda: mb.coil(C_STILL), 15, 0.05)
+        report("forcing off: Stop during a 20000 Um move stops the axis short of the quota (pymodbus), "
+               "sent through cSTOP's tag", stopped and mb.md(POSIT) < p0 + 15000
+               and "coil 20" in text(drv, "message"), f"{p0} -> {mb.md(POSIT)} {text(drv, 'message')}")
+
+        # ---- a tag list that does not fit the running program is not used ----
+        tj = os.path.join(proj, "build", "gen", "TAGS.json")
+        good = open(tj).read()
+        d = json.loads(good)
+        for t in d["tags"]:
+            if t["name"] == "CONFIG0.RES0.AXIS.SLVELASSE":
+                t["type"] = "INT"           # as in another program
+        open(tj, "w").write(json.dumps(d))
+        h = Http(wport)
+        h.login("olga", "olga-secret-1")
+        st, body = h.req("POST", "/api/write", {"path": "slvelasse", "value": "55"})
+        report("a tag list whose slVelAsse is of another type: not written there; refused in words, as forcing "
+               "is off (pymodbus still reads 41)", st == 409 and b"no Modbus tag" in body and b"allow_force" in body
+               and mb.md(SPEED) == 41, f"{st} {body[:300]} {mb.md(SPEED)}")
+        open(tj, "w").write(good)
+
+        # ---- the I/O backends: the remote I/O devices in words ----
+        drv.get(f"http://127.0.0.1:{wport}/overview")
+        wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 10, 0.05)
+
+        def state(name):
+            try:
+                return drv.find_element(By.CSS_SELECTOR, f"#ov-backend-1 tr[data-name='{name}'] td.state").text
+            except Exception:
+                return None
+        both = wait_for(lambda: state("rack") == "ok" and state("panel") == "ok", 15, 0.1)
+        regs = mb.c.read_input_registers(21000, 2, slave=1).registers     # backend 1: modbus_io
+        head = text(drv, "ov-backend-1")
+        report("overview: remote I/O devices rack and panel by their names, both ok, '2 of 2 devices ok' as plcrt "
+               "counts (input registers 21000-21001)", both and regs == [2, 2] and "2 of 2 devices ok" in head,
+               f"{head} {regs}")
+        drv.execute_script("document.getElementById('ov-backends').scrollIntoView()")
+        drv.save_screenshot(os.path.join(shots, "web-backends.png"))
+        peers.stop(rack)
+        lost = wait_for(lambda: state("rack") == "lost" and state("panel") == "ok", 15, 0.1)
+        regs = mb.c.read_input_registers(21000, 4, slave=1).registers
+        head = text(drv, "ov-backend-1")
+        report("the rack's server killed: the page shows rack lost, panel ok, a fault counted, as plcrt's "
+               "registers say (1 of 2 ok)", lost and regs[1] == 1 and (regs[2] << 16 | regs[3]) >= 1
+               and "1 of 2 devices ok" in head, f"{head} {regs}")
+        report("the tag list is named on the overview by its path from plcweb's folder, no folder above it",
+               "tags from " + os.path.relpath(os.path.join(proj, "build", "gen", "TAGS.json")) in text(drv, "ov-tags"),
+               text(drv, "ov-tags"))
+        drv.execute_script("document.getElementById('ov-backends').scrollIntoView()")
+        drv.save_screenshot(os.path.join(shots, "web-backends-lost.png"))
+    finally:
+        web.terminate()
+        web.wait(10)
+        peers.close()
 
 
 PLCOPEN_STATES = ["Disabled", "Standstill", "Homing", "DiscreteMotion", "ContinuousMotion",
