@@ -11,6 +11,7 @@ log="$dir/$name.log"
 : > "$log"
 echo "== $name"
 export CK_VERBOSITY=verbose CK_FORK=yes
+start=$(date +%s)
 "$@" 2>&1 | while IFS= read -r line; do
     printf '%s\n' "$line"
     if [[ $line =~ ^[^:]+:[0-9]+:([PFE]):([^:]+):([^:]+):[0-9]+:\ ?(.*)$ ]]; then
@@ -24,5 +25,6 @@ status=${PIPESTATUS[0]}
 if [ "$status" -ne 0 ] && ! grep -q '^FAIL: ' "$log"; then
     echo "FAIL: $name (exit status $status)" | tee -a "$log"
 fi
+echo "SUITE-TIME: $(($(date +%s) - start))" >> "$log"
 echo SUITE-END >> "$log"
 exit "$status"

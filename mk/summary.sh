@@ -18,6 +18,10 @@ done
 if [ -e "$dir/.make-failed" ] && [ "$fail" -eq 0 ]; then
     echo "  a test suite failed to build or run (see the make errors above)"; fail=$((fail + 1))
 fi
+# the slowest suites (wall seconds), to keep `make test` short
+slow=$(grep -H '^SUITE-TIME: ' "$dir"/*.log 2>/dev/null | sed 's|.*/\(.*\)\.log:SUITE-TIME: \(.*\)|\2 \1|' \
+       | sort -rn | head -n 6 | awk '{printf "%s%s %ss", (NR > 1 ? ", " : ""), $2, $1}')
+[ -n "$slow" ] && echo "slowest suites: $slow"
 echo
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ] && [ "$pass" -gt 0 ]
