@@ -145,14 +145,12 @@ if s:
 t_vel_end = time.time()
 stopping = at(lambda s: s["phase"] == 5 and s["statex"] == 6, 5)
 report("stop_held_stopping_y_geared", stopping is not None and stopping["statey"] == 5, f"{stopping or status()}")
-s = at(lambda s: s["phase"] == 7, 5)
-time.sleep(0.3)
-s = status()
+# in the 1 s pause after MC_GearOut: both at rest on their set-points
+s = at(lambda s: s["phase"] == 7 and s["statex"] == 1 and s["statey"] == 1 and s["ingear"] == 0
+       and abs(s["posx"] - s["setptx"]) <= 5 and abs(s["posy"] - s["setpty"]) <= 5, 5)
 report("gear_out_both_at_rest_on_set_points",
-       s.get("statex") == 1 and s.get("statey") == 1 and s.get("ingear") == 0
-       and abs(s["posx"] - s["setptx"]) <= 5 and abs(s["posy"] - s["setpty"]) <= 5
-       and abs(dx.pos - s["setptx"] * SCALE) <= 0.5 and abs(dy.pos - s["setpty"] * SCALE) <= 0.5,
-       f"{s}, drives at {dx.pos} {dy.pos} counts")
+       s is not None and abs(dx.pos - s["setptx"] * SCALE) <= 0.5 and abs(dy.pos - s["setpty"] * SCALE) <= 0.5,
+       f"{s or status()}, drives at {dx.pos} {dy.pos} counts")
 
 # ---- a drive fault while X runs the velocity move ----
 s = at(lambda s: s["phase"] == 4, 20)
