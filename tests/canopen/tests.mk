@@ -34,6 +34,13 @@ canopen_cia402: $(BUILD)/plc/cia402/plcrt | bus-backend
 	  @PY@ tests/canopen/plcrt_cia402_test.py $(BUILD)/plc/cia402/plcrt $(CO_BUILD)/uml_cia402
 TESTS += canopen_cia402
 STRESS_TESTS += canopen_cia402
+# the CODESYS-style PLCopen program (examples/plcopen) on the same two drives
+.PHONY: canopen_plcopen402
+canopen_plcopen402: $(BUILD)/plc/plcopen_cia402/plcrt | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_plcopen402 $(BUS_RUN) $(CO_BUILD)/uml_plcopen402 \
+	  @PY@ tests/canopen/plcrt_plcopen402_test.py $(BUILD)/plc/plcopen_cia402/plcrt $(CO_BUILD)/uml_plcopen402
+TESTS += canopen_plcopen402
+STRESS_TESTS += canopen_plcopen402
 
 # seed 000's DRIVETYPE 91: an APOSS axis on the analog output of a guarded CiA 401 module
 ifneq ($(ST_LIB),)
