@@ -42,7 +42,9 @@ for _ in $(seq 50); do
     sleep 0.1
 done
 if grep -q 'http://' "$weblog"; then
-    echo "$(grep -m1 'http://' "$weblog"): log in as demo, password $(cat "$pwfile") ($pwfile)"
+    # only the address line's own words: plcweb's log may follow in the file
+    addr=$(grep -m1 -o 'plcweb: http://[^ ]* (plcrt at [^)]*)' "$weblog")
+    echo "$addr: log in as demo, password $(cat "$pwfile") ($pwfile)"
 else
     echo "plcweb did not start (plcrt runs on): $(tail -n 3 "$weblog")"
 fi
