@@ -12,6 +12,7 @@ Prints PASS:/FAIL: lines."""
 import os
 import signal
 import socket
+import struct
 import subprocess
 import sys
 import time
@@ -115,6 +116,18 @@ if b.returncode == 0:
     s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
     s.bind(sock)
     s.settimeout(0.2)
+    # each message stamped by the kernel when it arrives (SO_TIMESTAMPNS, the
+    # wall clock), not when this loop gets to it on a loaded host
+    SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)      # Linux's value; Python may lack the name
+    s.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+
+    def recv_stamped():
+        data, anc, _, _ = s.recvmsg(4096, socket.CMSG_SPACE(16))
+        for level, kind, raw in anc:
+            if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS:
+                sec, nsec = struct.unpack("qq", raw[:16])
+                return sec + nsec / 1e9, data.decode()
+        return time.time(), data.decode()
     env = dict(os.environ, NOTIFY_SOCKET=sock, WATCHDOG_USEC=str(WD_US))
     log = open(os.path.join(work, "stall.log"), "w")
     p = subprocess.Popen([os.path.join(proj, "build", "plcrt"), "-c", "plcrt.ini"], cwd=proj, env=env,
@@ -124,13 +137,13 @@ if b.returncode == 0:
     c = ModbusTcpClient("127.0.0.1", port=sport)
     while time.monotonic() < end:
         try:
-            msgs.append((time.monotonic(), s.recv(4096).decode()))
+            msgs.append(recv_stamped())
         except socket.timeout:
             pass
         pings = [t for t, m in msgs if m == "WATCHDOG=1"]
         if t_stall is None and len(pings) >= 2:
             c.connect()
-            t_stall = time.monotonic()
+            t_stall = time.time()           # the stall begins when the write lands, after this
             c.write_coil(0, True, slave=1)
         if t_stall and len([t for t in pings if t > t_stall + 4]) >= 2:
             break
