@@ -618,8 +618,10 @@ def tags_and_backends(drv, plcrt, ini_src, users, work, shots):
         drv.execute_script("localStorage.setItem('plcweb.watch', JSON.stringify(arguments[0]))",
                            [{"path": "CONFIG0.RES0.AXIS.SLVELASSE", "type": "DINT"}])
         drv.refresh()
-        wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 10, 0.05)
-        row = drv.find_element(By.ID, "w-CONFIG0_RES0_AXIS_SLVELASSE")
+        wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 30, 0.05)
+        # the watch row appears once the page has the watch list's first values: poll for it
+        rows = wait_for(lambda: drv.find_elements(By.ID, "w-CONFIG0_RES0_AXIS_SLVELASSE"), 30, 0.05)
+        row = rows[0] if rows else drv.find_element(By.ID, "w-CONFIG0_RES0_AXIS_SLVELASSE")
         row.find_element(By.CSS_SELECTOR, "input").send_keys("41")
         row.find_element(By.CSS_SELECTOR, "button.write").click()
         said = wait_for(lambda: "Modbus write" in text(drv, "message") and text(drv, "message"), 10, 0.05)
