@@ -2,8 +2,8 @@
 """aposs_tune: seed 001's "ten steps for optimum control", automated, on a
 running plcrt with an APOSSAXIS (st/devices/apossaxis.st) whose parameters,
 commands and outputs are on the Modbus symbols of examples/aposs/aposs.ini.
-Every test run is a POSR recorded cycle by cycle with plcrt's trace
-(docs/trace.md); every measure comes from that record, in the program's
+Every test run is the axis's TESTRUN (a POSR framed by motor off) recorded
+cycle by cycle with plcrt's trace (docs/trace.md); every measure comes from that record, in the program's
 time (one task interval per cycle executed), never from the wall clock, and
 every wait is a count of PLC cycles: the same plant gives the same gains
 whatever the host's load.  The steps (docs/aposs.md, "Tuning"):
@@ -32,10 +32,12 @@ whatever the host's load.  The steps (docs/aposs.md, "Tuning"):
 Each step's run is the shortest move that shows what it measures: one that
 just reaches VEL for the ramps (step 4) and the oscillation after a move
 (step 5), one with 0.1 s at VEL for the constant speed (step 3) and for the
-following error all along a move (steps 6-9).  The
-axis is switched off and on before each run (it starts at rest where it
-is) and moves alternately towards its start position, so it stays within
-the software limits.  Written to --out: aposs-tune-report.txt (every run,
+following error all along a move (steps 6-9).  Each run is the axis's own
+TESTRUN: motor off, 200 ms at rest, MOTORON, POSR, the hold, motor off, each
+in a cycle the block chooses; so a run starts at rest where the last one
+left the axis, whenever the tool's writes land, and the tool's measures
+depend on the plant alone.  The moves alternate towards the start
+position, so the axis stays within the software limits.  Written to --out: aposs-tune-report.txt (every run,
 its gains and measures), aposs-tune-stepN.png per step (set-point and
 actual position, speed and following error of the step's last run, as the
 seed's Tune Oscilloscope shows them), aposs-tune-runN.csv (each capture),
@@ -68,11 +70,12 @@ _spec.loader.exec_module(plctrace)
 # the symbol map of examples/aposs/aposs.ini
 PARAMS = ("KPROP KDER KINT FFVEL FFACC BANDWIDTH POSERR KILIM POS VEL ACC DEC POSLIMIT NEGLIMIT "
           "SWPOSLIMACT SWNEGLIMACT VELMAX ENCODER RAMPMIN TESTWIN TESTTIM TESTVAL RAMPTYPE JERKMIN "
-          "ERRCOND HOME_TYPE HOME_VEL HOME_RAMP HOME_OFFSET HOME_FORCE").split()
+          "ERRCOND HOME_TYPE HOME_VEL HOME_RAMP HOME_OFFSET HOME_FORCE TESTRUN_REST TESTRUN_HOLD").split()
 HOLD = {p: 8192 + 2 * i for i, p in enumerate(PARAMS)}
-COILS = {c: 8192 + i for i, c in enumerate("MOTOROFF MOTORON ERRCLR STOP HOME POSA POSR CVEL".split())}
-INPUTS = {"APOS": (1152, "i"), "ERRNUM": (1154, "h"), "MODE": (1155, "h")}
-DISCRETE = {d: 8192 + i for i, d in enumerate("MOTOR BUSY INPOS HOMED ERROR".split())}
+COILS = {c: 8192 + i for i, c in enumerate("MOTOROFF MOTORON ERRCLR STOP HOME POSA POSR CVEL TESTRUN".split())}
+INPUTS = {"APOS": (1152, "i"), "ERRNUM": (1154, "h"), "MODE": (1155, "h"), "REFCODE": (1158, "h")}
+DISCRETE = {d: 8192 + i for i, d in enumerate("MOTOR BUSY INPOS HOMED ERROR LIMPOS LIMNEG BRAKE TESTING".split())}
+REST_MS = 200              # a test run's rest, motor off, before its MOTORON: the drive's lag died out
 CYCLES_REG = 1024           # plcrt's diagnostics: cycles executed (docs/modbus.md)
 GAINS = ("FFVEL", "FFACC", "KPROP", "KDER", "KINT", "BANDWIDTH")
 # trace channels, below the instance path (--instance)
@@ -148,7 +151,7 @@ class Tuner:
         self.period = st["period_ns"] * 1e-9
         self.cap = st["cap"]
         self.chans = [self.tr.lookup(f"{a.instance}.{c}") for c in CHANS]
-        self.trig = self.tr.lookup(f"{a.instance}.POSR")[0]
+        self.trig = self.tr.lookup(f"{a.instance}.TESTMOVE")[0]
         self.p0 = axis.out("APOS")
         vmx = axis.get("VELMAX") * axis.get("ENCODER") * 4 / 60.0
         self.v = vmx * a.vel / 100.0                        # qc/s, VELRES 100
@@ -159,7 +162,9 @@ class Tuner:
 
     # ---- one test run ----
     def capture(self, dist, post_s):
-        """POSR by dist qc recorded from 20 cycles before the command to
+        """One TESTRUN by dist qc (the axis: motor off, REST ms at rest,
+        MOTORON, POSR, post_s and a little more, motor off; made by the
+        block cycle by cycle) recorded from 20 cycles before its POSR to
         post_s after the set-point's end; columns by name, t in s of
         program time (cycles executed x the task interval)."""
         ax, tr = self.ax, self.tr
@@ -179,7 +184,9 @@ class Tuner:
             tr.command(plctrace.ARM, what="arm")
             ax.wait_cycles(pre + 2)                  # the pre-trigger samples are in
             ax.set("POS", self.sign * dist)
-            ax.pulse("POSR")
+            ax.set("TESTRUN_REST", REST_MS)
+            ax.set("TESTRUN_HOLD", round(1000 * post_s) + 30 * round(1000 * self.period) + 20)
+            ax.pulse("TESTRUN")
             c0 = ax.cycles()
             while True:
                 st = tr.status()
@@ -187,12 +194,18 @@ class Tuner:
                     break
                 if (ax.cycles() - c0) & 0xFFFFFFFF > 4 * n + 5000:
                     tr.command(plctrace.STOP, what="stop")
-                    raise SystemExit("aposs_tune: the trace did not trigger on POSR")
+                    raise SystemExit("aposs_tune: the trace did not trigger on the test run's POSR (TESTRUN "
+                                     f"refused: refcode {ax.out('REFCODE')}, error {ax.out('ERRNUM')})")
                 tr.command(plctrace.CLAIM, what="keep the trace")
                 ax.wait_cycles(20)
             rows = plctrace.download(tr, st)
         finally:
             tr.command(plctrace.RELEASE, what="release")
+        c0 = ax.cycles()
+        while ax.flag("TESTING"):                   # its hold, then motor off
+            if (ax.cycles() - c0) & 0xFFFFFFFF > n + 5000:
+                raise SystemExit("aposs_tune: the test run did not end")
+            ax.wait_cycles(10)
         cols = {}
         for (path, vals), name in zip(rows["cols"], CHANS):
             cols[name.split(".")[-1]] = [float(v) for v in vals]
@@ -211,9 +224,6 @@ class Tuner:
         ax = self.ax
         for k, v in gains.items():
             ax.set(k, v)
-        ax.pulse("MOTOROFF")
-        ax.wait_cycles(int(0.2 / self.period))      # at rest: the drive's lag has died out
-        ax.pulse("MOTORON")
         if ax.flag("ERROR"):
             raise SystemExit(f"aposs_tune: the axis has error {ax.out('ERRNUM')} (parameters: {gains})")
         self.sign = 1 if ax.out("APOS") <= self.p0 else -1
