@@ -15,26 +15,14 @@ here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/../.." && pwd)
 . "$top/tests/common/st_build.sh"
 out=$1 lib=$2 scans=${3:-3000} rounds=${4:-5} plcrt=${5:-}
-median() { sort -n | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
+. "$top/bench/common/scan_rounds.sh"
 for n in 1 256; do
     d="$out/axes$n"
     rm -rf "$d" && mkdir -p "$d"
     sed "s/@N@/$n/g" "$here/axes.st.in" > "$d/axes.st"
     cat "$lib" "$top/c_blocks/sim_axis.st" "$d/axes.st" > "$d/all.st"
-    st_compile "$d/all.st" "$d" "bench-aposs/axes$n" || exit 1
-    st_link "$d" "$here/driver.c" "$d/prog" "bench-aposs/axes$n" \
+    scan_rounds "bench-aposs/axes$n" "$d" "$d/all.st" "$here/driver.c" "$scans" "$rounds" \
         -I "$top/c_blocks" "$top/c_blocks/plant.c" || exit 1
-    : > "$d/rounds.txt"
-    for r in $(seq "$rounds"); do
-        "$d/prog" "$scans" >> "$d/rounds.txt" || exit 1
-    done
-    med=$(awk '{ print $2 }' "$d/rounds.txt" | median)
-    p99=$(awk '{ print $4 }' "$d/rounds.txt" | median)
-    moves=$(awk '{ print $6 }' "$d/rounds.txt" | median)
-    bad=$(awk '{ s += $8 } END { print s }' "$d/rounds.txt")
-    # the dearest scan of the least disturbed round: on a shared machine a
-    # round's maximum is often another process's time slice, not the scan's
-    max=$(awk '{ print $10 }' "$d/rounds.txt" | sort -n | head -1)
     eval "med$n=$med p99$n=$p99 max$n=$max"
     printf 'bench-aposs: %3d axes: %8.0f ns per scan median, %8.0f ns p99, %8.0f ns max (%s scans; median of %s rounds, max of the quietest); %s POSA per round, %s axes in error\n' \
         "$n" "$med" "$p99" "$max" "$scans" "$rounds" "$moves" "$bad"

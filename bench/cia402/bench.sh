@@ -10,22 +10,13 @@ here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/../.." && pwd)
 . "$top/tests/common/st_build.sh"
 out=$1 lib=$2 scans=${3:-3000} rounds=${4:-5}
-median() { sort -n | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
+. "$top/bench/common/scan_rounds.sh"
 for n in 1 64; do
     d="$out/drives$n"
     rm -rf "$d" && mkdir -p "$d"
     sed "s/@N@/$n/g" "$here/axes.st.in" > "$d/axes.st"
     cat "$lib" "$d/axes.st" > "$d/all.st"
-    st_compile "$d/all.st" "$d" "bench-cia402/drives$n" || exit 1
-    st_link "$d" "$top/bench/aposs/driver.c" "$d/prog" "bench-cia402/drives$n" || exit 1
-    : > "$d/rounds.txt"
-    for r in $(seq "$rounds"); do
-        "$d/prog" "$scans" >> "$d/rounds.txt" || exit 1
-    done
-    med=$(awk '{ print $2 }' "$d/rounds.txt" | median)
-    p99=$(awk '{ print $4 }' "$d/rounds.txt" | median)
-    moves=$(awk '{ print $6 }' "$d/rounds.txt" | median)
-    bad=$(awk '{ s += $8 } END { print s }' "$d/rounds.txt")
+    scan_rounds "bench-cia402/drives$n" "$d" "$d/all.st" "$top/bench/aposs/driver.c" "$scans" "$rounds" || exit 1
     eval "med$n=$med p99$n=$p99"
     printf 'bench-cia402: %2d drives: %8.0f ns per scan median, %8.0f ns p99 (%s scans, median of %s rounds); %s POSA per round, %s drives in error\n' \
         "$n" "$med" "$p99" "$scans" "$rounds" "$moves" "$bad"
