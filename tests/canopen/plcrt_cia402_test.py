@@ -70,6 +70,11 @@ def status(k):
     return dict(zip(("state", "bits", "errid", "errtrans", "errcode", "refused"), r)) if r else {}
 
 
+def cycles():
+    rr = mb.read_input_registers(1024, 2, slave=1)
+    return 0 if rr.isError() else rr.registers[0] << 16 | rr.registers[1]
+
+
 def bit(k, b):
     return (status(k).get("bits", 0) >> b) & 1
 
@@ -101,11 +106,12 @@ report("power_on_both", ok and d5.trans == [3, 4] and d6.trans == [3, 4] and d5.
 
 command(1, 3)                                   # home node 6: it says 250 mm
 ok = wait_for(lambda: bit(1, HOMED) and not bit(1, BUSY), 10) and wait_for(lambda: d6.get(0x6061) == 8, 5)
+# APOS and CPOS read apart: fair, the axis rests (homed, not busy) and each
+# is held against the drive's 250 mm alone
 report("home_mode_6", ok and md(13) == 250000 and md(14) == 250000 and d6.get(0x6061) == 8,
        f"APOS {md(13)} µm, CPOS {md(14)} µm, mode display {d6.get(0x6061)}")
 
 # axis 0: 0 -> 100 mm at 50 mm/s, 500 mm/s2: T = 100/50 + 50/500 = 2.1 s = 210 cycles
-t_move = time.time()
 command(0, 4, pos=100000, vel=50000, acc=500000)
 ok = wait_for(lambda: bit(0, INPOS) and not bit(0, BUSY), 15) and wait_for(lambda: md(3) == 100000, 5)
 report("move_absolute_in_position", ok and d5.get(0x6064) == 10000 and md(3) == 100000,
@@ -113,7 +119,10 @@ report("move_absolute_in_position", ok and d5.get(0x6064) == 10000 and md(3) == 
 # axis 1 from 250 mm: run at -20 mm/s, then stop (a = 500 mm/s2: 0.4 mm further)
 command(1, 5, vel=-20000, acc=500000)
 ok = wait_for(lambda: bit(1, ATVEL), 10)
-time.sleep(0.3)
+# 30 cycles at speed, counted by plcrt (input registers 1024-1025), not
+# 0.3 s slept: velocity_move_at_v below wants 20 of them on the bus
+c_at = cycles()
+wait_for(lambda: cycles() >= c_at + 30, 30)
 command(1, 6, acc=500000)
 ok2 = wait_for(lambda: bit(1, INPOS) and not bit(1, BUSY), 10)
 
