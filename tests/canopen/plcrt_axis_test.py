@@ -56,7 +56,7 @@ axis = Axis(net, 4, maxvel=40000.0)
 log = open(os.path.join(out, "plcrt.log"), "w")
 plc = subprocess.Popen([plcrt, "-c", cfg], stdout=log, stderr=subprocess.STDOUT)
 mb = ModbusTcpClient("127.0.0.1", port=PORT)
-ok = wait_for(lambda: mb.connect(), 10) and wait_for(lambda: axis.state == 5, 5)
+ok = wait_for(lambda: mb.connect(), 30) and wait_for(lambda: axis.state == 5, 20)
 report("startup", ok, f"node state {axis.state}")
 
 
@@ -80,7 +80,7 @@ def posit():
 
 # the program needs its first cycles to INIT and close the loop before a
 # START; how long those take depends on the machine, so count them
-report("program_running", wait_for(lambda: cycles() >= 5, 10), f"{cycles()} cycles")
+report("program_running", wait_for(lambda: cycles() >= 5, 30), f"{cycles()} cycles")
 mb.write_register(1024, 1, slave=1)                   # go
 t0 = time.monotonic()
 ok = wait_for(lambda: (hreg(1025) or [0])[0] & 1 == 1, 30)

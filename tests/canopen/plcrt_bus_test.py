@@ -74,10 +74,10 @@ net = connect("vcan0")
 s2, s3 = Slave401(net, 2), Slave401(net, 3)
 plc = Plcrt(ini(os.path.join(out, "plcrt.ini")))
 ok = plc.wait("2 of 2 nodes operational", 20) is not None
-ok = ok and wait_for(lambda: s2.state == 5 and s3.state == 5, 5)
+ok = ok and wait_for(lambda: s2.state == 5 and s3.state == 5, 20)
 report("startup", ok, f"states {s2.state} {s3.state}")
 mb = ModbusTcpClient("127.0.0.1", port=PORT)
-wait_for(lambda: mb.connect(), 5)
+wait_for(lambda: mb.connect(), 20)
 
 
 def ireg(addr, n=1):
