@@ -56,7 +56,7 @@ axis = Axis(net, 4, maxvel=40000.0)
 log = open(os.path.join(out, "plcrt.log"), "w")
 plc = subprocess.Popen([plcrt, "-c", cfg], stdout=log, stderr=subprocess.STDOUT)
 mb = ModbusTcpClient("127.0.0.1", port=PORT)
-ok = wait_for(lambda: mb.connect(), 10) and wait_for(lambda: axis.state == 5, 5)
+ok = wait_for(lambda: mb.connect(), 30) and wait_for(lambda: axis.state == 5, 20)
 report("startup", ok, f"node state {axis.state}")
 
 
@@ -80,30 +80,39 @@ def posit():
 
 # the program needs its first cycles to INIT and close the loop before a
 # START; how long those take depends on the machine, so count them
-report("program_running", wait_for(lambda: cycles() >= 5, 10), f"{cycles()} cycles")
+report("program_running", wait_for(lambda: cycles() >= 5, 30), f"{cycles()} cycles")
 mb.write_register(1024, 1, slave=1)                   # go
 t0 = time.monotonic()
-ok = wait_for(lambda: (hreg(1025) or [0])[0] & 1 == 1, 15)
+ok = wait_for(lambda: (hreg(1025) or [0])[0] & 1 == 1, 30)
+# the drive's count and the program's posit are each held against SETPOS
+# alone (the axis rests in its tolerance), never against each other: two
+# reads at different times compare fairly
 count = axis.get(0x2000)
 report("positioned_within_toll", ok and abs(count - SETPOS) <= TOLL and abs((posit() or 0) - SETPOS) <= TOLL,
        f"st_toll after {time.monotonic() - t0:.2f} s, encoder {count}, posit {posit()}")
-time.sleep(0.3)
+# it holds for 30 PLC cycles (counted, not slept for)
+n = cycles()
+wait_for(lambda: cycles() >= n + 30, 30)
 count = axis.get(0x2000)
 report("holds_position", abs(count - SETPOS) <= TOLL and abs(axis.get(0x6411, 1)) < 3000,
        f"encoder {count}, DAC {axis.get(0x6411, 1)}")
 
 t_stop = time.monotonic()
 axis.stop_heartbeat()
-emrg = wait_for(lambda: (hreg(1025) or [0])[0] & 2 == 2, 10)
+emrg = wait_for(lambda: (hreg(1025) or [0])[0] & 2 == 2, 30)
 report("node_lost_axis_emergency", emrg,
        f"{(time.monotonic() - t_stop) * 1000:.0f} ms, state {hreg(1025)}")
 # the emergency holds (no RESUME is sent) while the program keeps running
 n = cycles()
-wait_for(lambda: cycles() >= n + 20, 10)
+wait_for(lambda: cycles() >= n + 20, 30)
 report("emergency_holds", (hreg(1025) or [0])[0] & 2 == 2, f"state {hreg(1025)}")
 
+# the scan's worst wake latency as plcrt measured it (input registers
+# 1042-1043, us): the bound below is widened by it, not by a guess
+rr = mb.read_input_registers(1042, 2, slave=1)
+late = 0.0 if rr.isError() else (rr.registers[0] << 16 | rr.registers[1]) / 1e6
 plc.send_signal(signal.SIGTERM)
-plc.wait(10)
+plc.wait(30)
 
 # On the bus: the node's last heartbeat, then the consumer time; plcrt
 # notices the silence in its first cycle past it (its input is read once a
@@ -111,11 +120,12 @@ plc.wait(10)
 # past the timeout to the end is 0, and there is at least one.
 hb = [t for t, d in trace.frames(0x704) if d == b"\x05"]
 rpdo = trace.frames(0x204)
-t_cut = hb[-1] + HB_CONS + 3 * CYCLE if hb else float("inf")
+t_cut = hb[-1] + HB_CONS + 3 * CYCLE + late if hb else float("inf")
 after = [(t, int.from_bytes(d[:2], "little", signed=True)) for t, d in rpdo if t >= t_cut]
 moving = [v for t, v in rpdo if hb and t < hb[-1]]
 bad = [(round((t - hb[-1]) * 1000), v) for t, v in after if v != 0]
 report("dac_zero_within_a_cycle_of_emergency",
        after and not bad and any(v != 0 for v in moving),
        (f"{len(after)} RPDOs from {(t_cut - hb[-1]) * 1000:.0f} ms after the last heartbeat, "
-        + (f"non-zero (ms, DAC): {bad[:5]}" if bad else "all 0")) if hb else "no heartbeat recorded")
+        + (f"non-zero (ms, DAC): {bad[:5]}" if bad else "all 0") + f"; worst wake latency {late * 1000:.1f} ms")
+       if hb else "no heartbeat recorded")

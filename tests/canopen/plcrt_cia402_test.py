@@ -47,7 +47,7 @@ d6 = Drive402(net, 6, home_at=25000)
 log = open(os.path.join(out, "plcrt.log"), "w")
 plc = subprocess.Popen([plcrt, "-c", cfg], stdout=log, stderr=subprocess.STDOUT)
 mb = ModbusTcpClient("127.0.0.1", port=PORT)
-ok = wait_for(lambda: mb.connect(), 10) and wait_for(lambda: d5.state == 5 and d6.state == 5, 10)
+ok = wait_for(lambda: mb.connect(), 30) and wait_for(lambda: d5.state == 5 and d6.state == 5, 30)
 report("startup_both_nodes_operational", ok, f"NMT states {d5.state} {d6.state}")
 seqs = [0, 0]
 
@@ -70,6 +70,11 @@ def status(k):
     return dict(zip(("state", "bits", "errid", "errtrans", "errcode", "refused"), r)) if r else {}
 
 
+def cycles():
+    rr = mb.read_input_registers(1024, 2, slave=1)
+    return 0 if rr.isError() else rr.registers[0] << 16 | rr.registers[1]
+
+
 def bit(k, b):
     return (status(k).get("bits", 0) >> b) & 1
 
@@ -87,11 +92,11 @@ def command(k, cmd, pos=0, vel=0, acc=0):
 
 
 POWERED, BUSY, INPOS, HOMED, ERROR, ATVEL = 0, 1, 2, 3, 4, 5
-wait_for(lambda: status(0).get("state") == 3 and status(1).get("state") == 3, 10)
+wait_for(lambda: status(0).get("state") == 3 and status(1).get("state") == 3, 30)
 d5.trans, d6.trans = [], []
 command(0, 1)
 command(1, 1)
-ok = wait_for(lambda: bit(0, POWERED) and bit(1, POWERED), 10)
+ok = wait_for(lambda: bit(0, POWERED) and bit(1, POWERED), 30)
 report("dcf_written_at_startup", d5.get(0x6065) == 2000 and d6.get(0x6065) == 2000
        and d5._mapping(0x1600, 0) == [(0x6040, 0, 16), (0x6060, 0, 8), (0x607A, 0, 32)]
        and d6._mapping(0x1A00, 1) == [(0x606C, 0, 32), (0x603F, 0, 16)],
@@ -100,47 +105,51 @@ report("power_on_both", ok and d5.trans == [3, 4] and d6.trans == [3, 4] and d5.
        f"transitions {d5.trans} {d6.trans}, states {status(0)} {status(1)}")
 
 command(1, 3)                                   # home node 6: it says 250 mm
-ok = wait_for(lambda: bit(1, HOMED) and not bit(1, BUSY), 10) and wait_for(lambda: d6.get(0x6061) == 8, 5)
+ok = wait_for(lambda: bit(1, HOMED) and not bit(1, BUSY), 30) and wait_for(lambda: d6.get(0x6061) == 8, 20)
+# APOS and CPOS read apart: fair, the axis rests (homed, not busy) and each
+# is held against the drive's 250 mm alone
 report("home_mode_6", ok and md(13) == 250000 and md(14) == 250000 and d6.get(0x6061) == 8,
        f"APOS {md(13)} µm, CPOS {md(14)} µm, mode display {d6.get(0x6061)}")
 
 # axis 0: 0 -> 100 mm at 50 mm/s, 500 mm/s2: T = 100/50 + 50/500 = 2.1 s = 210 cycles
-t_move = time.time()
 command(0, 4, pos=100000, vel=50000, acc=500000)
-ok = wait_for(lambda: bit(0, INPOS) and not bit(0, BUSY), 15) and wait_for(lambda: md(3) == 100000, 5)
+ok = wait_for(lambda: bit(0, INPOS) and not bit(0, BUSY), 45) and wait_for(lambda: md(3) == 100000, 20)
 report("move_absolute_in_position", ok and d5.get(0x6064) == 10000 and md(3) == 100000,
        f"drive position {d5.get(0x6064)} counts, APOS {md(3)} µm")
 # axis 1 from 250 mm: run at -20 mm/s, then stop (a = 500 mm/s2: 0.4 mm further)
 command(1, 5, vel=-20000, acc=500000)
-ok = wait_for(lambda: bit(1, ATVEL), 10)
-time.sleep(0.3)
+ok = wait_for(lambda: bit(1, ATVEL), 30)
+# 30 cycles at speed, counted by plcrt (input registers 1024-1025), not
+# 0.3 s slept: velocity_move_at_v below wants 20 of them on the bus
+c_at = cycles()
+wait_for(lambda: cycles() >= c_at + 30, 30)
 command(1, 6, acc=500000)
-ok2 = wait_for(lambda: bit(1, INPOS) and not bit(1, BUSY), 10)
+ok2 = wait_for(lambda: bit(1, INPOS) and not bit(1, BUSY), 30)
 
 # ---- the load of drive 5 blocked during a move: the drive's following
 # error (window 0x6065 = 2000 counts from its DCF) is a fault, EMCY 0x8611 ----
 d5.stuck = True
 d5.trans = []
 command(0, 4, pos=0, vel=50000, acc=500000)
-ok3 = wait_for(lambda: bit(0, ERROR), 10)
+ok3 = wait_for(lambda: bit(0, ERROR), 30)
 st0 = status(0)
 report("following_error_fault", ok3 and st0.get("errid") == 1 and st0.get("errcode") == 0x8611
        and d5.trans == [13, 14], f"status {st0}, drive {d5.state_name}, transitions {d5.trans}")
 d5.stuck = False
 d5.trans = []
 command(0, 7)
-ok = wait_for(lambda: bit(0, POWERED) and not bit(0, ERROR), 10)
+ok = wait_for(lambda: bit(0, POWERED) and not bit(0, ERROR), 30)
 report("reset_after_following_error", ok and d5.trans == [15, 2, 3, 4], f"transitions {d5.trans}, status {status(0)}")
 
 # ---- a drive fault during a move (EMCY 0x2310, overcurrent) ----
 command(0, 4, pos=0, vel=50000, acc=500000)
-wait_for(lambda: bit(0, BUSY), 5)
+wait_for(lambda: bit(0, BUSY), 20)
 d5.fault(0x2310)
-ok3 = wait_for(lambda: bit(0, ERROR), 10)
+ok3 = wait_for(lambda: bit(0, ERROR), 30)
 st0 = status(0)
 command(1, 5, vel=10000, acc=500000)            # the other axis keeps moving
 p1 = md(13)
-wait_for(lambda: (md(13) or 0) > (p1 or 0) + 500, 10)
+wait_for(lambda: (md(13) or 0) > (p1 or 0) + 500, 30)
 p2 = md(13)
 report("drive_fault_is_axis_error", ok3 and st0.get("errid") == 1 and st0.get("errcode") == 0x2310
        and d5.st == 8, f"status {st0}, drive state {d5.state_name}")
@@ -149,33 +158,33 @@ report("other_axis_keeps_moving", p1 is not None and p2 is not None and p2 > p1 
 command(1, 6, acc=500000)
 d5.trans = []
 command(0, 7)
-ok = wait_for(lambda: bit(0, POWERED) and not bit(0, ERROR), 10)
+ok = wait_for(lambda: bit(0, POWERED) and not bit(0, ERROR), 30)
 report("fault_reset_powers_again", ok and d5.trans == [15, 2, 3, 4], f"transitions {d5.trans}, status {status(0)}")
 command(0, 4, pos=50000, vel=50000, acc=500000)
-ok = wait_for(lambda: bit(0, INPOS) and not bit(0, BUSY), 15) and wait_for(lambda: d5.get(0x6064) == 5000, 5)
+ok = wait_for(lambda: bit(0, INPOS) and not bit(0, BUSY), 45) and wait_for(lambda: d5.get(0x6064) == 5000, 20)
 report("moves_after_reset", ok and d5.get(0x6064) == 5000, f"drive position {d5.get(0x6064)}")
 
 # ---- drive 6 sends TPDOs cut short: its inputs are stale, the axis goes
 # to error 5 (offline) and stops; drive 5 is not touched ----
 command(1, 5, vel=10000, acc=500000)
-wait_for(lambda: bit(1, ATVEL), 10)
+wait_for(lambda: bit(1, ATVEL), 30)
 t_short = time.time()
 d6.short_tpdo = 3
-ok = wait_for(lambda: bit(1, ERROR), 10)
+ok = wait_for(lambda: bit(1, ERROR), 30)
 st1 = status(1)
 p1 = md(3)
 report("short_tpdo_axis_error", ok and st1.get("errid") == 5 and bit(0, POWERED),
        f"status {st1}, axis 0 powered {bit(0, POWERED)}")
 d6.short_tpdo = 0
-ok = wait_for(lambda: status(1).get("state") == 5 or status(1).get("state") == 6 or status(1).get("state") == 2, 10)
+ok = wait_for(lambda: status(1).get("state") == 5 or status(1).get("state") == 6 or status(1).get("state") == 2, 30)
 command(1, 7)
-ok = wait_for(lambda: bit(1, POWERED) and not bit(1, ERROR), 10)
+ok = wait_for(lambda: bit(1, POWERED) and not bit(1, ERROR), 30)
 report("short_tpdo_reset_after_good_frames", ok, f"status {status(1)}")
 
 d5.trans, d6.trans = [], []
 command(0, 2)
 command(1, 2)
-ok = wait_for(lambda: d5.st == 3 and d6.st == 3, 5)
+ok = wait_for(lambda: d5.st == 3 and d6.st == 3, 20)
 report("power_off_both", ok and d5.trans == [8] and d6.trans == [8], f"{d5.trans} {d6.trans}")
 plc.send_signal(signal.SIGTERM)
 report("plcrt_exits_0", plc.wait(10) == 0)

@@ -254,17 +254,26 @@ if mdir and os.path.exists(axis):
                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         from pymodbus.client import ModbusTcpClient
         c = ModbusTcpClient("127.0.0.1", port=port)
-        end = time.time() + 10
+        end = time.time() + 30
         while not c.connect() and time.time() < end:
             time.sleep(0.1)
+
+        def cycles():
+            r = c.read_input_registers(1024, 2, slave=1)
+            return 0 if r.isError() else r.registers[0] << 16 | r.registers[1]
         x0 = sim_position()
         c.write_registers(10000, [0, 1500], slave=1)    # target := 1500 Um
         c.write_coil(10000, True, slave=1)              # go
-        end, x = time.time() + 15, None
+        # a deadline only; "stays" is 30 PLC cycles later, counted by plcrt,
+        # not 0.3 s slept (a loaded host may run few cycles in it)
+        end, x = time.time() + 60, None
         while time.time() < end:
             x = sim_position()
             if isinstance(x, int) and abs(x - 1500) <= 5:
-                time.sleep(0.3)
+                n = cycles()
+                end = time.time() + 30
+                while cycles() < n + 30 and time.time() < end:
+                    time.sleep(0.02)
                 x = sim_position()
                 break
             time.sleep(0.1)

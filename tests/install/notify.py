@@ -24,6 +24,23 @@ exe, ini, work = sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3])
 os.makedirs(work, exist_ok=True)
 report = Report("install/notify")
 WD_US = 2000000   # WatchdogSec=2s
+SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)      # Linux's value; Python may lack the name
+
+
+def stamping(s):
+    """Each message stamped by the kernel when it arrives (SO_TIMESTAMPNS,
+    the wall clock), not when this script gets to it on a loaded host."""
+    s.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+
+
+def recv_stamped(s):
+    """(arrival time, text) of the next message on s."""
+    data, anc, _, _ = s.recvmsg(4096, socket.CMSG_SPACE(16))
+    for level, kind, raw in anc:
+        if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS:
+            sec, nsec = struct.unpack("qq", raw[:16])
+            return sec + nsec / 1e9, data.decode()
+    return time.time(), data.decode()
 
 
 def run(tag, addr, bind, watchdog_pid=None, seconds=4.5):
@@ -35,6 +52,7 @@ def run(tag, addr, bind, watchdog_pid=None, seconds=4.5):
     s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
     s.bind(bind)
     s.settimeout(0.2)
+    stamping(s)
     env = dict(os.environ, NOTIFY_SOCKET=addr, WATCHDOG_USEC=str(WD_US))
     if watchdog_pid:
         env["WATCHDOG_PID"] = str(watchdog_pid)
@@ -44,8 +62,8 @@ def run(tag, addr, bind, watchdog_pid=None, seconds=4.5):
     deadline = t0 + 30   # plcrt's start-up on a loaded machine, then `seconds` of pings
     while time.monotonic() < deadline:
         try:
-            m = s.recv(4096).decode()
-            msgs.append((time.monotonic(), m))
+            msgs.append(recv_stamped(s))
+            m = msgs[-1][1]
             if m.startswith("READY=1"):
                 deadline = time.monotonic() + seconds
         except socket.timeout:
@@ -60,9 +78,8 @@ def run(tag, addr, bind, watchdog_pid=None, seconds=4.5):
         rc = p.wait()
     try:
         while True:
-            m = s.recv(4096).decode()
-            msgs.append((time.monotonic(), m))
-            stopped = stopped or m == "STOPPING=1"
+            msgs.append(recv_stamped(s))
+            stopped = stopped or msgs[-1][1] == "STOPPING=1"
     except (socket.timeout, OSError):
         pass
     s.close()
@@ -116,18 +133,7 @@ if b.returncode == 0:
     s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
     s.bind(sock)
     s.settimeout(0.2)
-    # each message stamped by the kernel when it arrives (SO_TIMESTAMPNS, the
-    # wall clock), not when this loop gets to it on a loaded host
-    SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)      # Linux's value; Python may lack the name
-    s.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
-
-    def recv_stamped():
-        data, anc, _, _ = s.recvmsg(4096, socket.CMSG_SPACE(16))
-        for level, kind, raw in anc:
-            if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS:
-                sec, nsec = struct.unpack("qq", raw[:16])
-                return sec + nsec / 1e9, data.decode()
-        return time.time(), data.decode()
+    stamping(s)
     env = dict(os.environ, NOTIFY_SOCKET=sock, WATCHDOG_USEC=str(WD_US))
     log = open(os.path.join(work, "stall.log"), "w")
     p = subprocess.Popen([os.path.join(proj, "build", "plcrt"), "-c", "plcrt.ini"], cwd=proj, env=env,
@@ -137,7 +143,7 @@ if b.returncode == 0:
     c = ModbusTcpClient("127.0.0.1", port=sport)
     while time.monotonic() < end:
         try:
-            msgs.append(recv_stamped())
+            msgs.append(recv_stamped(s))
         except socket.timeout:
             pass
         pings = [t for t, m in msgs if m == "WATCHDOG=1"]

@@ -21,7 +21,7 @@ import sys
 from importlib.machinery import SourceFileLoader
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Plcrt, Report, free_port, wait_for  # noqa: E402
+from peer import Plcrt, Report, free_port  # noqa: E402
 
 tree, work = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
 os.makedirs(work, exist_ok=True)
@@ -68,9 +68,16 @@ try:
     quota = next(x for x in mb if "2048 5000" in x)
     startl = next(x for x in mb if "-r 2 1" in x)
     r = sh(rec[0], port)
-    wait_for(lambda: False, 1.5)          # the record command arms the trace
+    # the START only once plctrace says it is armed (it says so once plcrt
+    # looks for the trigger): a stimulus sent after a fixed wait could come
+    # before that on a loaded host, and no capture would follow
+    head = []
+    for line in r.stdout:
+        head.append(line)
+        if line.startswith("armed"):
+            break
     mv = sh("; ".join([setup, quota, startl]), port).communicate(timeout=60)[0]
-    out = r.communicate(timeout=120)[0]
+    out = "".join(head) + r.communicate(timeout=120)[0]
     path = os.path.join(work, "move.csv")
     rows = list(csv.reader(open(path))) if os.path.exists(path) else []
     report("the README's record command captures", r.returncode == 0 and len(rows) == 8001, out[-500:] + mv[-300:])

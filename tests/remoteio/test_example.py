@@ -12,7 +12,6 @@ import signal
 import subprocess
 import sys
 import threading
-import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "common"))
@@ -66,6 +65,7 @@ finally:
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)
         p.wait()
-time.sleep(0.5)
-report("stopped: plcrt's outputs safe", any("outputs safe" in x for x in lines), "\n".join(lines[-5:]))
+# the reader thread may still be taking the last lines: polled for
+report("stopped: plcrt's outputs safe", wait_for(lambda: any("outputs safe" in x for x in lines), 20),
+       "\n".join(lines[-5:]))
 sys.exit(0 if report.all_passed() else 1)

@@ -40,9 +40,13 @@ def mbpoll(*args):
 
 
 try:
-    report("plcrt says it serves the line", wait_for(lambda: "modbus_rtu: serving on" in plc.output(), 5))
+    report("plcrt says it serves the line", wait_for(lambda: "modbus_rtu: serving on" in plc.output(), 20))
     rc, out = mbpoll("-t", "4", "-r", "1024", line.b, "111", "2222", "333")
     report("mbpoll -m rtu writes %MW0-%MW2 (holding 1024-1026)", rc == 0, out[-300:])
+    # the write reaches the image at the next cycle, the TCP reads at that
+    # cycle's end: polled for
+    wait_for(lambda: (lambda x: not x.isError() and x.registers == [111, 2222, 333])(
+        tcp.read_holding_registers(1024, 3)), 20)
     r = tcp.read_holding_registers(1024, 3)
     report("... and they are in the map plcrt serves over TCP", not r.isError() and r.registers == [111, 2222, 333],
            f"{r}")
@@ -54,7 +58,7 @@ try:
     cl.connect()
     c0 = cl.read_input_registers(1024, 2, slave=SLAVE)
     c1 = wait_for(lambda: (lambda r: r if not r.isError() and r.registers != c0.registers else None)(
-        cl.read_input_registers(1024, 2, slave=SLAVE)), 5)
+        cl.read_input_registers(1024, 2, slave=SLAVE)), 20)
     report("pymodbus reads the diagnostics over RTU: the cycle count advances", not c0.isError() and c1, f"{c0}")
     r = cl.read_holding_registers(60000, 4, slave=SLAVE)
     report("pymodbus: the trace block too (the same map)", not r.isError(), f"{r}")
@@ -70,13 +74,16 @@ try:
     good = bytes([SLAVE, 3, 0x04, 0x00, 0x00, 0x01])
     for junk in (b"\xff" * 40, good + b"\x00\x00", good[:3], bytes(range(256)), good + b"\x12"):
         os.write(fd, junk)
-        wait_for(lambda: False, 0.3)
+        wait_for(lambda: False, 0.3)       # silence between them (a frame's end); longer when late is fine
     os.close(fd)
     cl.close()
     cl.connect()
-    r = wait_for(lambda: (lambda x: x if not x.isError() else None)(cl.read_holding_registers(1024, 3, slave=SLAVE)), 5)
+    r = wait_for(lambda: (lambda x: x if not x.isError() else None)(cl.read_holding_registers(1024, 3, slave=SLAVE)), 20)
     report("after noise, a bad CRC, cut and oversize frames: the next request answered",
            r and r.registers == [111, 2222, 333], f"{r}")
+    # counted by the RTU server, published at a cycle's end: polled for
+    wait_for(lambda: (lambda b: b[0] << 16 | b[1] > bad0[0] << 16 | bad0[1])(
+        tcp.read_input_registers(1024 + 52, 2).registers), 20)
     bad1 = tcp.read_input_registers(1024 + 52, 2).registers
     report("malformed frames counted (input registers 1076-1077)", bad1[0] << 16 | bad1[1] > bad0[0] << 16 | bad0[1],
            f"{bad0} -> {bad1}")

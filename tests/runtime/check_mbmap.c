@@ -358,7 +358,10 @@ START_TEST(threads_never_tear)
         req(3, 2048 + 200, 2); OK(3);
         ck_assert_uint_eq((uint32_t)reg(0) << 16 | reg(1), v); /* its own write, whole */
     }
-    for (int k = 0; k < 10000 && mb_flush(m); k++) usleep(100);   /* the last batch lands */
+    /* the last batch lands: counted tries, up to a minute, for a loaded host */
+    int pending = 1;
+    for (int k = 0; k < 600000 && (pending = mb_flush(m)); k++) usleep(100);
+    ck_assert_msg(!pending, "the scan thread did not take the last writes");
     atomic_store(&scan_stop, 1);
     pthread_join(th, NULL);
     ck_assert_int_eq(torn_in_program, 0);

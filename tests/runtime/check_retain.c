@@ -252,13 +252,17 @@ START_TEST(kill9_loop)
             }
         }
         close(p[1]);
+        /* every other round the kill comes after a first save completed, so
+        ** that rounds with progress do not depend on how soon a loaded host
+        ** runs the child; the others may kill it before any save */
+        uint64_t g, last = gen;
+        if (round % 2 && read(p[0], &g, sizeof g) == sizeof g) last = g;
         struct timespec d = { 0, (rand() % 4000) * 1000L };
         nanosleep(&d, NULL);
         kill(pid, SIGKILL);
         int st;
         waitpid(pid, &st, 0);
         ck_assert(WIFSIGNALED(st));
-        uint64_t g, last = gen;
         while (read(p[0], &g, sizeof g) == sizeof g) last = g;
         close(p[0]);
         fill(1000000);
@@ -282,7 +286,7 @@ START_TEST(kill9_loop)
         }
         gen = got;
     }
-    ck_assert_int_lt(no_progress, 200);
+    ck_assert_int_le(no_progress, 100);
 }
 END_TEST
 

@@ -11,7 +11,7 @@ printf '[plc]\nstatus_interval = 0\n[modbus]\nport = %s\n' "$port" > "$out/names
 "$plcrt" -c "$out/names.ini" > "$out/plcrt.log" 2>&1 &
 pid=$!
 ok=0
-for _ in $(seq 50); do
+for _ in $(seq 300); do      # a generous deadline (30 s): a loaded host starts slowly
     sleep 0.1
     # holding registers 1024..1026 are %MW0..2
     v=$(mbpoll -m tcp -p "$port" -0 -1 -r 1024 -c 3 -t 4 127.0.0.1 2>/dev/null | sed -n 's/^\[102[4-6]\]:[[:space:]]*//p' | tr '\n' ' ')

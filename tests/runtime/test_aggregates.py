@@ -11,12 +11,11 @@ import os
 import signal
 import struct
 import sys
-import time
 
 from pymodbus.client import ModbusTcpClient
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Plcrt, Report, free_port  # noqa: E402
+from peer import Plcrt, Report, free_port, wait_for  # noqa: E402
 
 PLCRT, WORK = sys.argv[1], sys.argv[2]
 PORT = free_port()
@@ -88,7 +87,11 @@ def main():
            not diff(got, DECLARED), str(diff(got, DECLARED)))
     for reg, (name, _, fmt) in ITEMS.items():
         c.write_registers(reg, regs(WRITTEN[name], fmt), slave=1)
-    time.sleep(0.1)
+    # a symbol's write reaches the program at the next cycle, and reads see
+    # it once that cycle is published: polled for; the values are static
+    # from then on (nothing but this test writes them), so the separate
+    # reads of read_all compare fairly
+    wait_for(lambda: not diff(read_all(c), WRITTEN), 20, 0.05)
     got = read_all(c)
     report("symbols: each element and member written alone (neighbours untouched)",
            not diff(got, WRITTEN), str(diff(got, WRITTEN)))
@@ -103,8 +106,14 @@ def main():
     # kill -9 after a periodic save
     c.write_registers(9000, regs(777, ">i"), slave=1)
     c.write_registers(9006, regs(-1, ">h"), slave=1)
+    # two saves counted by plcrt (input registers 1056-1057) after the
+    # writes (period = 1 s): the second began after they were applied
+    def saves():
+        r = c.read_input_registers(1024 + 32, 2, slave=1).registers
+        return r[0] << 16 | r[1]
+    s0 = saves()
+    wait_for(lambda: saves() >= s0 + 2, 30, 0.1)
     c.close()
-    time.sleep(2.5)   # period = 1 s: at least one save has happened since
     p.stop(signal.SIGKILL)
     p = Plcrt(PLCRT, cfg, WORK, "plcrt")
     c = client()

@@ -24,7 +24,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Plcrt, Report, free_port  # noqa: E402
+from peer import Plcrt, Report, free_port, wait_for  # noqa: E402
 from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 PLCRT, PLCRT_1MS, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
@@ -129,37 +129,50 @@ def test_slow_bytes(port):
             break
     stop[0] = True
     th.join()
+    # the server's rule is in wall-clock time, so is this check; the lower
+    # bound is exact (t0 is taken before the first byte leaves), the upper
+    # one holds what this script may be late in seeing the close on a loaded
+    # host, and stays under the whole frame's 2.4 s (a rule per gap, or per
+    # frame once whole, would never cut it)
     report("a frame sent one byte every 0.2 s is cut 0.5 s after its first byte",
-           cut is not None and 0.45 <= cut <= 1.0, f"closed after {cut} s" if cut else "never closed, or answered")
-    report("meanwhile another client is served without delay", served[0] >= 10 and worst[0] < 0.25,
+           cut is not None and 0.45 <= cut <= 1.5, f"closed after {cut} s" if cut else "never closed, or answered")
+    # a server that waited for the slow frame would hold the other client
+    # up to the 0.5 s cut: the bound is under that, with room for this
+    # script's own lateness under load
+    report("meanwhile another client is served without delay", served[0] >= 3 and worst[0] < 0.45,
            f"{served[0]} replies, slowest {worst[0] * 1000:.0f} ms")
     slow.close()
     other.close()
 
 
 def test_idle(port):
+    # idle_timeout is wall-clock time: the lower bounds are exact (the
+    # test's clock starts first), the upper ones leave this script 1 s to
+    # see the close on a loaded host
     silent = connect(port)
     t = closed_within(silent, IDLE + 2)
     report(f"a silent client is closed after idle_timeout ({IDLE} s)",
-           t is not None and IDLE - 0.1 <= t <= IDLE + 0.6, f"closed after {t} s")
+           t is not None and IDLE - 0.1 <= t <= IDLE + 1.0, f"closed after {t} s")
     silent.close()
     once = connect(port)
     once.sendall(frame(7, fc3(0, 1)))
     r = reply(once)
     t = closed_within(once, IDLE + 2)
     report("a client silent after a request is closed idle_timeout after it",
-           r is not None and r[0] == 7 and t is not None and IDLE - 0.1 <= t <= IDLE + 0.6, f"reply {r}, closed after {t} s")
+           r is not None and r[0] == 7 and t is not None and IDLE - 0.1 <= t <= IDLE + 1.0, f"reply {r}, closed after {t} s")
     once.close()
 
 
 def test_cap(port):
-    time.sleep(0.2)                       # the connections of the tests before are gone
+    # no connection of the tests before is left: the server itself closed
+    # test_idle's (so it had run rounds past test_slow_bytes' close). The
+    # order of idleness is that of the replies below (plcrt counts requests
+    # in sequence, not in time), so no pause is needed between them.
     old = []
     for i in range(CAP):
         s = connect(port)
         s.sendall(frame(10 + i, fc3(0, 1)))
         old.append((s, reply(s)))
-        time.sleep(0.05)
     ok_before = all(r is not None and r[0] == 10 + i for i, (_, r) in enumerate(old))
     new = connect(port)
     new.sendall(frame(20, fc3(0, 1)))
@@ -247,8 +260,10 @@ def test_atomic(port):
     rs = [threading.Thread(target=reader) for _ in range(2)]
     for t in rs:
         t.start()
-    writes, t_end = 0, time.monotonic() + 1.5
-    while time.monotonic() < t_end:
+    # counted, not timed: at least 200 writes and 200 reads beside them
+    # (a deadline only for a server that stops answering)
+    writes, t_end = 0, time.monotonic() + 60
+    while time.monotonic() < t_end and not (writes >= 200 and reads[0] >= 200 and {A, B} <= seen):
         v = A if writes % 2 == 0 else B
         if w.write_registers(addr, [v >> 16, v & 0xFFFF], slave=1).isError():
             break
@@ -258,7 +273,7 @@ def test_atomic(port):
         t.join()
     w.close()
     report("a reader never sees half of a %MD value another client rewrites",
-           not torn and writes > 50 and {A, B} <= seen,
+           not torn and writes >= 200 and reads[0] >= 200 and {A, B} <= seen,
            f"{writes} writes, {reads[0]} reads, torn: {torn[:5]}, seen {[hex(x) for x in seen]}")
 
 
@@ -268,12 +283,11 @@ def test_flood():
     try:
         c = ModbusTcpClient("127.0.0.1", port=port, timeout=3)
         c.connect()
-        time.sleep(0.3)
 
         def d(off):
             return u32(c.read_input_registers(DIAG + off, 2, slave=1).registers)
         own0, req0 = d(40), d(28)
-        stop, counts = [False], []
+        stop, counts, total = [False], [], [0]
 
         def flood():
             s = connect(port)
@@ -284,20 +298,26 @@ def test_flood():
                 if reply(s) is None:
                     break
                 n += 1
+                total[0] += 1
             counts.append(n)
             s.close()
         ts = [threading.Thread(target=flood) for _ in range(15)]
         for t in ts:
             t.start()
-        time.sleep(3)
+        # 6000 requests (3 s of them on an idle 2-core machine), counted,
+        # not timed; the deadline is for a server that stops answering
+        wait_for(lambda: total[0] >= 6000 or not any(t.is_alive() for t in ts), 120, 0.05)
         stop[0] = True
         for t in ts:
             t.join()
-        time.sleep(0.05)
+        # the diagnostics are published at a cycle's end: two cycles after
+        # the last reply they count every request
+        n = d(0)
+        wait_for(lambda: d(0) >= n + 2, 20)
         own, served, xmax, emax = d(40) - own0, d(28) - req0, d(46), d(10)
         c.close()
         report("16 clients flooding FC 3 of 125 registers: no overrun of the scan's own",
-               own == 0 and served > 1000, f"{own} overruns, {served} requests in 3 s, worst execution {emax} us")
+               own == 0 and served >= 6000, f"{own} overruns, {served} requests, worst execution {emax} us")
         # measured on the scan's path around mb_apply and mb_publish: a copy
         # takes microseconds to tens of them (the cache lines come from the
         # server's core); waiting for client threads took 10-17 ms

@@ -70,6 +70,9 @@ def main():
         mb = ModbusTcpClient("127.0.0.1", port=port, timeout=3)
         mb.connect()
         st, w = post("/api/write", {"path": "slvelasse", "value": "37"})
+        # the write reaches the program at the next cycle and the reads after
+        # that cycle's end: polled for
+        wait_for(lambda: mb.read_holding_registers(2050, 2, slave=1).registers == [0, 37], 20, 0.02)
         r = mb.read_holding_registers(2050, 2, slave=1).registers
         report("a parameter written from the page without forcing: slVelAsse 37 read back by pymodbus "
                "(holding 2050), written through its tag", st == 200 and r == [0, 37]
