@@ -36,9 +36,10 @@ TESTS += canopen_cia402
 STRESS_TESTS += canopen_cia402
 # the CODESYS-style PLCopen program (examples/plcopen) on the same two drives
 .PHONY: canopen_plcopen402
-canopen_plcopen402: $(BUILD)/plc/plcopen_cia402/plcrt | bus-backend
+canopen_plcopen402: $(BUILD)/plc/plcopen_cia402/plcrt $(BUILD)/plc/plcopen/plcrt | bus-backend
 	@mk/suite.sh $(RESULTS) canopen_plcopen402 $(BUS_RUN) $(CO_BUILD)/uml_plcopen402 \
-	  @PY@ tests/canopen/plcrt_plcopen402_test.py $(BUILD)/plc/plcopen_cia402/plcrt $(CO_BUILD)/uml_plcopen402
+	  @PY@ tests/canopen/plcrt_plcopen402_test.py $(BUILD)/plc/plcopen_cia402/plcrt $(CO_BUILD)/uml_plcopen402 \
+	  $(BUILD)/plc/plcopen/plcrt
 TESTS += canopen_plcopen402
 STRESS_TESTS += canopen_plcopen402
 
