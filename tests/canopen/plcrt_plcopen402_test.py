@@ -36,8 +36,9 @@ its start + n x 10 ms (its row there, or the line between the rows around
 a time an overrun skipped, off the profile by 2A dt^2 / 8 at most, dt the
 gap: allowed for; a gap over 20 ms is not compared, half of the 10 ms
 points at least are).  Overruns of either run thus move neither side of
-a comparison.  The bus start is the call before X's set-point first moves
-(the move after the homing waits for the drive to show CSP).
+a comparison.  The bus start is the call before the axis' set-point first
+moves (Y geared: X's; the move after the homing waits for each drive to
+show CSP, checked against its mode display in the same trace).
 
 Bound, closed form.  Both runs plan the same moves: speed v, and speed
 changes dv whose duration is dv / A with A = 500000 Um/s2 (the bus
