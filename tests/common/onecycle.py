@@ -25,6 +25,7 @@ import os
 import re
 import struct
 import subprocess
+import sys
 
 from peer import default_signals
 
@@ -123,7 +124,9 @@ class Recording:
     row per sample."""
 
     def __init__(self, port, chans, trigger, samples, path, pre=0, every=1, timeout=60):
-        argv = [PLCTRACE, "--port", str(port), "record", "--trigger", trigger, "--pre", str(pre),
+        # under this interpreter: it has plctrace's pymodbus (a bus test's
+        # guest has another python3 first on its PATH)
+        argv = [sys.executable, PLCTRACE, "--port", str(port), "record", "--trigger", trigger, "--pre", str(pre),
                 "--samples", str(samples), "--every", str(every), "--timeout", str(timeout),
                 "--no-plot", "-o", path]
         for c in chans:
