@@ -6,8 +6,9 @@ analog output 1 of CiA 401 node 4 (slave401.Slave401, DRIVETYPE 91): the
 encoder sits on the shaft of the motor that output drives.  Both nodes are
 guarded.  The encoder starts 6000 counts below 2^31 and a POSA carries it
 across; then it stops answering guarding during a move: error 88 and the
-reference 0 on the bus from the first cycle past guard time x life factor
-(kernel timestamps of the recorded frames); ERRCLR while it is silent
+reference 0 on the bus within guard time x life factor / cycle + 4 RPDOs
+of its last answer (the recorded frames, with their kernel timestamps
+reported); ERRCLR while it is silent
 raises 88 again; a negative ENCODERTYPE lets ERRCLR stand; a wrong id is
 refused (parerr 27, AP held); answering again, AP is the encoder's value
 and the axis moves; as device type 1 (incremental) a reset of the node with
@@ -30,10 +31,9 @@ from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 plcrt, out = sys.argv[1], sys.argv[2]
 PORT = 15036
-# the encoder guarded every 100 ms, lost after 5 missed answers; the module
-# carrying the reference (not under test here) after 10: a test process
-# stalled by a loaded host must not look like a silent node
-GUARD, LIFE, CYCLE = 0.100, 5, 0.010
+# both nodes guarded every 100 ms and lost after 10 missed answers: this
+# test process, stalled by a loaded host, must not look like a silent node
+GUARD, LIFE, CYCLE = 0.100, 10, 0.010
 TESTWIN = 50
 POSERR = 20000
 VMAX = 40000.0                  # qc/s at 10 V: the motor model's, VELMAX 600 rpm x ENCODER 1000 x 4
@@ -297,20 +297,28 @@ t_last = max([a for a in answers if a < t_silent], default=None)
 if t_last is None:
     report("reference_zero_past_life_time", False, "no guarding answer of the encoder recorded")
 else:
-    deadline = t_last + GUARD * LIFE
+    # bounded in the PLC's own cycles (one RPDO each), so that a stalled
+    # plcrt (it reports its overruns) cannot fail it: the answer is taken at
+    # the next cycle's start, the loss seen in the first cycle past the life
+    # time from there, APOSSAXIS opens the loop in that call and its DAC is 0
+    # from the next: the (life time / cycle + 2)th or, by the scan's jitter,
+    # the next RPDO after the last answer is 0, one later still if the cycle
+    # that took the answer woke late (the life time counts from its start);
+    # so every RPDO from the (+ 4)th on (the master itself zeroes only the
+    # lost node's RPDOs, and the encoder has none)
+    limit = round(GUARD * LIFE / CYCLE) + 4
     nxt = min([a for a in answers if a > t_last], default=float("inf"))
-    # three cycles: the answer is taken at the next cycle's start, the loss
-    # seen in the first cycle past the life time from there, and APOSSAXIS
-    # opens the loop in that call, its DAC 0 from the next (the master
-    # itself zeroes only the RPDOs of the lost node, here the encoder)
-    after = [(t, d) for t, d in rpdo if deadline + 3 * CYCLE <= t < nxt]
+    after = [(t, d) for t, d in rpdo if t_last < t < nxt]
     moving = [t for t, d in rpdo if t_last - 0.2 < t < t_last and int.from_bytes(d[:2], "little", signed=True)]
-    bad = [round((t - t_last) * 1000) for t, d in after if any(d)]
-    first0 = min([t for t, d in rpdo if t > t_last and not any(d)], default=None)
-    report("reference_zero_past_life_time", after and not bad and moving and running,
-           (f"first zero RPDO {(first0 - t_last) * 1000:.0f} ms after the encoder's last answer "
-            f"(guard {GUARD * 1000:.0f} ms x life {LIFE} + 3 cycles of {CYCLE * 1000:.0f} ms); "
-            + (f"non-zero at {bad[:5]} ms" if bad else f"{len(after)} RPDOs after, all 0")
+    bad = [k + 1 for k, (t, d) in enumerate(after) if k + 1 >= limit and any(d)]
+    # the first of the zeros that last until the node answers again
+    first0 = max([k + 2 for k, (t, d) in enumerate(after) if any(d)], default=1)
+    first0 = first0 if first0 <= len(after) else None
+    ms0 = (after[first0 - 1][0] - t_last) * 1000 if first0 else 0
+    report("reference_zero_past_life_time", len(after) > limit and not bad and moving and running,
+           (f"the reference 0 from the {first0}th RPDO after the encoder's last answer, {ms0:.0f} ms after it (limit: the "
+            f"{limit}th, guard {GUARD * 1000:.0f} ms x life {LIFE} / cycle {CYCLE * 1000:.0f} ms + 4); "
+            + (f"non-zero at RPDOs {bad[:5]}" if bad else f"{len(after) - limit + 1} RPDOs from the limit on, all 0")
             + f"; {len(moving)} non-zero in the 200 ms before, silenced {(t_silent - t_last) * 1000:.0f} ms "
             f"after that answer")
            if first0 else "no zero RPDO")
