@@ -42,6 +42,8 @@ typedef struct nodecfg_ex {
     int hb_given;           /* a heartbeat_* key was set */
     int guard_given;        /* guard_time_ms was set */
     int drivetype;          /* seed 000 DRIVETYPE +-91..94 of an APOSS axis on this node, or 0 */
+    long encodertype;       /* seed 000 ENCODERTYPE of an APOSS axis whose encoder is this node, or 0 */
+    char enc_text[24];      /* as written, for messages */
     char eds[256];          /* the node's EDS/DCF file, or "" */
     plc_loc status, ok;
     int has_status, has_ok;
@@ -311,6 +313,20 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         ex->drivetype = (int)d;
         return 0;
     }
+    if (!strcmp(key, "encodertype")) {
+        char *end;
+        long d = strtol(v, &end, 10);
+        long a = labs(d) % 100000, dev = a / 1000, id = a % 1000;
+        if (end == v || *end || labs(d) > 199999 || dev < 1 || dev > 50 || id < 1 || id > 127) {
+            snprintf(err, n, "encodertype '%s': seed 000's bus encoders are guard x (busoffset + device type "
+                     "x 1000 + id): guard +1 (guarded) or -1, busoffset 0 or 100000, device type 1..50 "
+                     "(50 a CiA 406 encoder), id the node's, e.g. 50005 or -50005 for a CiA 406 encoder on node 5", v);
+            return -1;
+        }
+        ex->encodertype = d;
+        snprintf(ex->enc_text, sizeof ex->enc_text, "%ld", d);
+        return 0;
+    }
     if (!strcmp(key, "life_factor")) {
         if (num(v, 255, &x, err, n) || x < 1) {
             snprintf(err, n, "life factor '%s' must be 1..255", v);
@@ -375,7 +391,8 @@ static int config(void *vs, const char *section, const char *key, const char *v,
         return 0;
     }
     snprintf(err, n, "unknown key (known: id, device_type, heartbeat_producer_ms, "
-             "heartbeat_consumer_ms, guard_time_ms, life_factor, drivetype, eds, rpdo1..4, tpdo1..4, bind, status, ok)");
+             "heartbeat_consumer_ms, guard_time_ms, life_factor, drivetype, encodertype, eds, rpdo1..4, tpdo1..4, bind, "
+             "status, ok)");
     return -1;
 }
 
@@ -544,6 +561,52 @@ static int use_eds(st *s, int i, char *err, size_t n)
     return 0;
 }
 
+/* seed 000 ENCODERTYPE: the id in it is the node's; a CiA 406 encoder
+   (device type 50) without PDO keys or EDS gets its position value 0x6004
+   in TPDO2, synchronous, as CiA 406 predefines it and the seed's "data
+   exchange via PDO 2" says; every other PDO is switched off */
+static int encoder_node(st *s, int i, char *err, size_t n)
+{
+    co_node_cfg *c = &s->nodes[i].cfg;
+    nodecfg_ex *ex = &s->ex[i];
+    long a = labs(ex->encodertype) % 100000;
+    if (a % 1000 != c->id) {
+        snprintf(err, n, "[%s] encodertype %s names node %ld, but the section's id is %u: write "
+                 "encodertype = %ld", ex->name, ex->enc_text, a % 1000, c->id,
+                 (ex->encodertype < 0 ? -1 : 1) * (labs(ex->encodertype) - a % 1000 + c->id));
+        return -1;
+    }
+    if (a / 1000 == 50 && !ex->pdo_given && !ex->eds[0]) {
+        memset(c->rpdo, 0, sizeof c->rpdo);
+        memset(c->tpdo, 0, sizeof c->tpdo);
+        for (unsigned k = 0; k < CO_PDO_PER_NODE; k++)
+            c->rpdo[k].trans = c->tpdo[k].trans = 1;
+        c->tpdo[1].n = 1;
+        c->tpdo[1].e[0] = (co_map_entry){ 0x6004, 0, 32 };
+    }
+    return 0;
+}
+
+/* the position value must reach the program: a bind of a 32-bit TPDO object
+   (0x6004:00 for a CiA 406 encoder) to a double word */
+static int encoder_bound(st *s, int i, char *err, size_t n)
+{
+    nodecfg_ex *ex = &s->ex[i];
+    int enc406 = labs(ex->encodertype) % 100000 / 1000 == 50;
+    for (int k = 0; k < s->nbinds; k++) {
+        const bind *b = &s->binds[k];
+        if (b->node != i || !b->tx || b->bit >= 0 || b->bits != 32)
+            continue;
+        if (!enc406 || (b->index == 0x6004 && b->sub == 0))
+            return 0;
+    }
+    snprintf(err, n, "[%s] encodertype %s: no 32-bit position value bound to the program: add %s",
+             ex->name, ex->enc_text, enc406 ? "bind = 0x6004:00 %ID0 (the encoder's position value, "
+             "in its TPDO2)" : "a tpdoN key mapping the drive's position (e.g. 0x6064:00:32) and bind = "
+             "0x6064:00 %ID0");
+    return -1;
+}
+
 static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
 {
     st *s = vs;
@@ -559,11 +622,15 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
         co_node_cfg *c = &s->nodes[i].cfg;
         if (s->ex[i].eds[0] && use_eds(s, i, err, n))
             return -1;
-        if (s->ex[i].drivetype && !s->ex[i].hb_given) {
-            /* seed 000: the module is guarded (DRIVETYPE > 0) or not watched at all */
-            if (s->ex[i].drivetype > 0 && !s->ex[i].guard_given)
+        if (s->ex[i].encodertype && encoder_node(s, i, err, n))
+            return -1;
+        if ((s->ex[i].drivetype || s->ex[i].encodertype) && !s->ex[i].hb_given) {
+            /* seed 000: the module is guarded (DRIVETYPE or ENCODERTYPE > 0)
+               or not watched at all */
+            int guarded = s->ex[i].drivetype > 0 || s->ex[i].encodertype > 0;
+            if (guarded && !s->ex[i].guard_given)
                 c->guard_ms = 100;
-            if (s->ex[i].drivetype < 0)
+            if (!guarded)
                 c->guard_ms = 0;
             c->hb_producer_ms = 0;
             c->hb_consumer_ms = 0;
@@ -586,6 +653,9 @@ static int open_(void *vs, plc_image *img, uint64_t tick, char *err, size_t n)
     }
     for (int i = 0; i < s->nbinds; i++)
         if (resolve(s, &s->binds[i], err, n))
+            return -1;
+    for (int i = 0; i < s->nnodes; i++)
+        if (s->ex[i].encodertype && encoder_bound(s, i, err, n))
             return -1;
     if (inputs_apart(s, img, err, n))
         return -1;
@@ -658,9 +728,10 @@ static int rd(void *vs, plc_image *img, uint64_t now_ns)
     }
     for (int i = 0; i < s->nnodes; i++) {
         co_node *nd = &s->nodes[i];
+        unsigned fresh = nd->rx_new ? 0x80 : 0;    /* bit 7: a TPDO came since the last cycle */
         nd->rx_new = 0;
         if (s->ex[i].has_status) {
-            uint16_t w = (uint16_t)(nd->fault | nd->phase << 8);
+            uint16_t w = (uint16_t)(nd->fault | fresh | nd->phase << 8);
             memcpy(plc_loc_ptr(img, &s->ex[i].status), &w, 2);
         }
         if (s->ex[i].has_ok)

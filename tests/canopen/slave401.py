@@ -224,7 +224,9 @@ class _GuardListener(can.Listener):
         if not msg.is_remote_frame or msg.arbitration_id != 0x700 + s.id:
             return
         s.guard_rtrs += 1
-        if s.guard_answer:
+        # not while booting (state 0): a real node answers from
+        # pre-operational on, and a state 0 answer reads as a boot-up
+        if s.guard_answer and s.state != 0:
             s.network.send_message(0x700 + s.id, [s.state | s.toggle])
             s.toggle ^= 0x80
 

@@ -65,3 +65,15 @@ canopen_eds: $(CO_BUILD)/eds_test
 	@mkdir -p $(CO_BUILD)/eds_files
 	@mk/suite.sh $(RESULTS) canopen_eds $< $(CO_BUILD)/eds_files
 TESTS += canopen_eds
+
+# seed 000's ENCODERTYPE 50: the APOSS axis' loop closed through a guarded CiA 406
+# encoder (node 5), its reference on the analog output of a CiA 401 module (node 4)
+ifneq ($(ST_LIB),)
+$(eval $(call plcrt_program,canopen_enc,$(ST_LIB) tests/canopen/st/canopen_enc.st))
+.PHONY: canopen_encodertype
+canopen_encodertype: $(BUILD)/plc/canopen_enc/plcrt | bus-backend
+	@mk/suite.sh $(RESULTS) canopen_encodertype $(BUS_RUN) $(CO_BUILD)/uml_encodertype \
+	  @PY@ tests/canopen/plcrt_encodertype_test.py $(BUILD)/plc/canopen_enc/plcrt $(CO_BUILD)/uml_encodertype
+TESTS += canopen_encodertype
+STRESS_TESTS += canopen_encodertype
+endif
