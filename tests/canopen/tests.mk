@@ -1,39 +1,33 @@
 # plcrt as the CANopen master (included from plc_runtime/part.mk once the
 # runtime is there): the real-bus tests of plcrt inside a kernel with CAN
 # (tests/canopen/bus_run.sh).
-$(eval $(call plcrt_program,canopen_io,tests/canopen/st/canopen_io.st))
 
-.PHONY: canopen_plcrt
-canopen_plcrt: $(BUILD)/plc/canopen_io/plcrt | bus-backend
-	@mk/suite.sh $(RESULTS) canopen_plcrt $(BUS_RUN) $(CO_BUILD)/uml_plcrt \
-	  @PY@ tests/canopen/plcrt_bus_test.py $(BUILD)/plc/canopen_io/plcrt $(CO_BUILD)/uml_plcrt
-TESTS += canopen_plcrt
-STRESS_TESTS += canopen_plcrt
+# bus_suite SUITE,SCRIPT,PLCRT: SCRIPT (Python) run in the bus kernel with
+# PLCRT (nothing for a suite without plcrt) and its folder there,
+# CO_BUILD/uml_NAME for SUITE canopen_NAME; in make test and make test-stress
+define bus_suite
+.PHONY: $(1)
+$(1): $(3) | bus-backend
+	@mk/suite.sh $$(RESULTS) $(1) $$(BUS_RUN) $$(CO_BUILD)/uml_$(patsubst canopen_%,%,$(1)) \
+	  @PY@ $(2) $(3) $$(CO_BUILD)/uml_$(patsubst canopen_%,%,$(1))
+TESTS += $(1)
+STRESS_TESTS += $(1)
+endef
+
+$(eval $(call plcrt_program,canopen_io,tests/canopen/st/canopen_io.st))
+$(eval $(call bus_suite,canopen_plcrt,tests/canopen/plcrt_bus_test.py,$(BUILD)/plc/canopen_io/plcrt))
 
 # the CAN-driven axis, once the positioner library is there
 ifneq ($(ST_LIB),)
 $(eval $(call plcrt_program,canopen_axis,$(ST_LIB) tests/canopen/st/canopen_axis.st))
-.PHONY: canopen_axis
-canopen_axis: $(BUILD)/plc/canopen_axis/plcrt | bus-backend
-	@mk/suite.sh $(RESULTS) canopen_axis $(BUS_RUN) $(CO_BUILD)/uml_axis \
-	  @PY@ tests/canopen/plcrt_axis_test.py $(BUILD)/plc/canopen_axis/plcrt $(CO_BUILD)/uml_axis
-TESTS += canopen_axis
-STRESS_TESTS += canopen_axis
+$(eval $(call bus_suite,canopen_axis,tests/canopen/plcrt_axis_test.py,$(BUILD)/plc/canopen_axis/plcrt))
 endif
 
 # the simulated CiA 402 drive against the standard's table and python-canopen's
 # BaseNode402, then plcrt driving two of them with CIA402DRIVE (examples/cia402)
-.PHONY: canopen_drive402 canopen_cia402
-canopen_drive402: | bus-backend
-	@mk/suite.sh $(RESULTS) canopen_drive402 $(BUS_RUN) $(CO_BUILD)/uml_drive402 \
-	  @PY@ tests/canopen/drive402_test.py $(CO_BUILD)/uml_drive402
-TESTS += canopen_drive402
-STRESS_TESTS += canopen_drive402
-canopen_cia402: $(BUILD)/plc/cia402/plcrt | bus-backend
-	@mk/suite.sh $(RESULTS) canopen_cia402 $(BUS_RUN) $(CO_BUILD)/uml_cia402 \
-	  @PY@ tests/canopen/plcrt_cia402_test.py $(BUILD)/plc/cia402/plcrt $(CO_BUILD)/uml_cia402
-TESTS += canopen_cia402
-STRESS_TESTS += canopen_cia402
+$(eval $(call bus_suite,canopen_drive402,tests/canopen/drive402_test.py,))
+$(eval $(call bus_suite,canopen_cia402,tests/canopen/plcrt_cia402_test.py,$(BUILD)/plc/cia402/plcrt))
+MATIEC_TESTS += canopen_cia402
 # the CODESYS-style PLCopen program (examples/plcopen) on the same two drives,
 # against its sim-plant run (taken on the host first)
 .PHONY: canopen_plcopen402
@@ -42,16 +36,13 @@ canopen_plcopen402: $(BUILD)/plc/plcopen_cia402/plcrt $(BUILD)/plc/plcopen/plcrt
 	  $(BUILD)/plc/plcopen_cia402/plcrt $(BUILD)/plc/plcopen/plcrt $(CO_BUILD)/uml_plcopen402
 TESTS += canopen_plcopen402
 STRESS_TESTS += canopen_plcopen402
+MATIEC_TESTS += canopen_plcopen402
 
 # seed 000's DRIVETYPE 91: an APOSS axis on the analog output of a guarded CiA 401 module
 ifneq ($(ST_LIB),)
 $(eval $(call plcrt_program,canopen_aposs,$(ST_LIB) tests/canopen/st/canopen_aposs.st))
-.PHONY: canopen_drivetype
-canopen_drivetype: $(BUILD)/plc/canopen_aposs/plcrt | bus-backend
-	@mk/suite.sh $(RESULTS) canopen_drivetype $(BUS_RUN) $(CO_BUILD)/uml_drivetype \
-	  @PY@ tests/canopen/plcrt_drivetype_test.py $(BUILD)/plc/canopen_aposs/plcrt $(CO_BUILD)/uml_drivetype
-TESTS += canopen_drivetype
-STRESS_TESTS += canopen_drivetype
+$(eval $(call bus_suite,canopen_drivetype,tests/canopen/plcrt_drivetype_test.py,$(BUILD)/plc/canopen_aposs/plcrt))
+MATIEC_TESTS += canopen_drivetype
 endif
 
 # the EDS/DCF reader (CiA 306), under the sanitizers: it reads vendors' files
@@ -70,10 +61,6 @@ TESTS += canopen_eds
 # encoder (node 5), its reference on the analog output of a CiA 401 module (node 4)
 ifneq ($(ST_LIB),)
 $(eval $(call plcrt_program,canopen_enc,$(ST_LIB) tests/canopen/st/canopen_enc.st))
-.PHONY: canopen_encodertype
-canopen_encodertype: $(BUILD)/plc/canopen_enc/plcrt | bus-backend
-	@mk/suite.sh $(RESULTS) canopen_encodertype $(BUS_RUN) $(CO_BUILD)/uml_encodertype \
-	  @PY@ tests/canopen/plcrt_encodertype_test.py $(BUILD)/plc/canopen_enc/plcrt $(CO_BUILD)/uml_encodertype
-TESTS += canopen_encodertype
-STRESS_TESTS += canopen_encodertype
+$(eval $(call bus_suite,canopen_encodertype,tests/canopen/plcrt_encodertype_test.py,$(BUILD)/plc/canopen_enc/plcrt))
+MATIEC_TESTS += canopen_encodertype
 endif
