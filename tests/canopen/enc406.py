@@ -16,26 +16,16 @@ as a real one does) does not lose it; it is integrated at each SYNC on the
 SYNC frames' kernel timestamps before the TPDO goes out, and sent wrapping
 at 2^32 as the encoder's 32-bit value does.
 """
-from canopen.objectdictionary import ODRecord, ODVariable, ObjectDictionary
+from canopen.objectdictionary import ODRecord
 from canopen.objectdictionary import datatypes as dt
 
-from slave401 import Slave401, var
+from slave401 import Slave401, comm_objects, var
 
 CIA406_TYPE = 0x00010196
 
 
 def build_od406(node_id):
-    od = ObjectDictionary()
-    od.add_object(var("device type", 0x1000, 0, dt.UNSIGNED32, "ro", CIA406_TYPE))
-    od.add_object(var("error register", 0x1001, 0, dt.UNSIGNED8, "ro", 0))
-    od.add_object(var("producer heartbeat time", 0x1017, 0, dt.UNSIGNED16, "rw", 0))
-    od.add_object(var("guard time", 0x100C, 0, dt.UNSIGNED16, "rw", 0))
-    od.add_object(var("life time factor", 0x100D, 0, dt.UNSIGNED8, "rw", 0))
-    name = ODVariable("device name", 0x1008, 0)
-    name.data_type = dt.VISIBLE_STRING
-    name.access_type = "const"
-    name.default = "CiA406 encoder"
-    od.add_object(name)
+    od = comm_objects(CIA406_TYPE, "CiA406 encoder")
     for base, fc in ((0x1400, 0x200), (0x1800, 0x180)):
         for i in range(4):
             r = ODRecord(f"PDO comm {i}", base + i)

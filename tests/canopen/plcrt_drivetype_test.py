@@ -18,10 +18,10 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from apossmb import AxisMb  # noqa: E402
 from slave401 import Axis, CanDump, connect  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from peer import Report, wait_for  # noqa: E402
-from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 plcrt, out = sys.argv[1], sys.argv[2]
 PORT = 15035
@@ -62,44 +62,9 @@ net = connect("vcan0")
 axis = Axis(net, 4, maxvel=40000.0)
 log = open(os.path.join(out, "plcrt.log"), "w")
 plc = subprocess.Popen([plcrt, "-c", cfg], stdout=log, stderr=subprocess.STDOUT)
-mb = ModbusTcpClient("127.0.0.1", port=PORT)
+mb = AxisMb(PORT)
 ok = wait_for(lambda: mb.connect(), 10) and wait_for(lambda: axis.state == 5, 5)
-seq = [0]
-
-
-def mw(a, n=1):
-    rr = mb.read_holding_registers(1024 + a, n, slave=1)
-    return None if rr.isError() else rr.registers
-
-
-def md(a):
-    rr = mb.read_holding_registers(2048 + 2 * a, 2, slave=1)
-    if rr.isError():
-        return None
-    v = rr.registers[0] << 16 | rr.registers[1]
-    return v - (1 << 32) if v & 0x80000000 else v
-
-
-def put_md(a, v):
-    v &= 0xFFFFFFFF
-    mb.write_registers(2048 + 2 * a, [v >> 16, v & 0xFFFF], slave=1)
-
-
-def command(c, pos=None):
-    if pos is not None:
-        put_md(1, pos)
-    seq[0] += 1
-    mb.write_registers(1024, [c, seq[0]], slave=1)
-
-
-def bits():
-    r = mw(3)
-    return r[0] if r else 0
-
-
-def errnum():
-    r = mw(2)
-    return r[0] if r else None
+mw, md, put_md, command, bits, errnum = mb.mw, mb.md, mb.put_md, mb.command, mb.bits, mb.errnum
 
 
 MOTOR, BUSY, INPOS, ERROR, BUSERR = 1, 2, 4, 8, 16

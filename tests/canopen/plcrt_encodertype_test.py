@@ -23,11 +23,11 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from apossmb import AxisMb  # noqa: E402
 from slave401 import CanDump, Slave401, connect  # noqa: E402
 from enc406 import Encoder406  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from peer import Report, wait_for  # noqa: E402
-from pymodbus.client import ModbusTcpClient  # noqa: E402
 
 plcrt, out = sys.argv[1], sys.argv[2]
 PORT = 15036
@@ -95,51 +95,9 @@ module = Slave401(net, 4)
 enc = Encoder406(net, 5, module, pos=START, maxvel=VMAX)
 log = open(os.path.join(out, "plcrt.log"), "w")
 plc = subprocess.Popen([plcrt, "-c", cfg], stdout=log, stderr=subprocess.STDOUT)
-mb = ModbusTcpClient("127.0.0.1", port=PORT)
+mb = AxisMb(PORT)
 ok = wait_for(lambda: mb.connect(), 10) and wait_for(lambda: module.state == 5 and enc.state == 5, 5)
-seq = [0]
-
-
-def mw(a, n=1):
-    rr = mb.read_holding_registers(1024 + a, n, slave=1)
-    return None if rr.isError() else rr.registers
-
-
-def mds(a, n):
-    """n double words from %MD a on, in one request: one cycle's values"""
-    rr = mb.read_holding_registers(2048 + 2 * a, 2 * n, slave=1)
-    if rr.isError():
-        return None
-    r = rr.registers
-    v = [r[2 * k] << 16 | r[2 * k + 1] for k in range(n)]
-    return [x - (1 << 32) if x & 0x80000000 else x for x in v]
-
-
-def md(a):
-    r = mds(a, 1)
-    return r[0] if r else None
-
-
-def put_md(a, v):
-    v &= 0xFFFFFFFF
-    mb.write_registers(2048 + 2 * a, [v >> 16, v & 0xFFFF], slave=1)
-
-
-def command(c, pos=None):
-    if pos is not None:
-        put_md(1, pos)
-    seq[0] += 1
-    mb.write_registers(1024, [c, seq[0]], slave=1)
-
-
-def bits():
-    r = mw(3)
-    return r[0] if r else 0
-
-
-def errnum():
-    r = mw(2)
-    return r[0] if r else None
+mw, mds, md, put_md, command, bits, errnum = mb.mw, mb.mds, mb.md, mb.put_md, mb.command, mb.bits, mb.errnum
 
 
 def signed(v):

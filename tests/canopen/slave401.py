@@ -36,9 +36,10 @@ def array(od, name, index, n, dtype, access="rw"):
     od.add_object(a)
 
 
-def build_od(node_id, device_type=CIA401_TYPE, encoder=False):
-    """A CiA 401 dictionary: 8 digital input/output bytes, 4 analog inputs and
-    outputs (INTEGER16); with encoder=True also 0x2000 an INTEGER32 count."""
+def comm_objects(device_type, device_name):
+    """A dictionary with CiA 301's communication objects a small node has:
+    device type, error register, heartbeat, guard time and life time
+    factor (written by the master), device name."""
     od = ObjectDictionary()
     od.add_object(var("device type", 0x1000, 0, dt.UNSIGNED32, "ro", device_type))
     od.add_object(var("error register", 0x1001, 0, dt.UNSIGNED8, "ro", 0))
@@ -48,8 +49,15 @@ def build_od(node_id, device_type=CIA401_TYPE, encoder=False):
     name = ODVariable("device name", 0x1008, 0)
     name.data_type = dt.VISIBLE_STRING
     name.access_type = "const"
-    name.default = "CiA401 slave"
+    name.default = device_name
     od.add_object(name)
+    return od
+
+
+def build_od(node_id, device_type=CIA401_TYPE, encoder=False):
+    """A CiA 401 dictionary: 8 digital input/output bytes, 4 analog inputs and
+    outputs (INTEGER16); with encoder=True also 0x2000 an INTEGER32 count."""
+    od = comm_objects(device_type, "CiA401 slave")
     for base, fc in ((0x1400, 0x200), (0x1800, 0x180)):
         for i in range(4):
             r = ODRecord(f"PDO comm {i}", base + i)
