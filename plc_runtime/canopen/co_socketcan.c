@@ -5,6 +5,7 @@
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 #include <fcntl.h>
 #include <linux/can.h>
@@ -42,6 +43,8 @@ int co_can_open(const char *ifname, char *err, size_t errlen)
     }
     can_err_mask_t mask = CAN_ERR_MASK;
     setsockopt(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &mask, sizeof mask);
+    int on = 1;                 /* receive timestamps: a frame's age (co_can_recv) */
+    setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
     struct sockaddr_can addr;
     memset(&addr, 0, sizeof addr);
     addr.can_family = AF_CAN;
@@ -97,11 +100,34 @@ int co_can_send_many(int fd, const co_frame *f, int n)
     return r;
 }
 
-int co_can_recv(int fd, co_frame *f)
+/* ns from the kernel's receive timestamp of msg to now (both wall clock:
+ * what SO_TIMESTAMPNS gives); 0 without one or if the clock stepped back */
+static co_time frame_age(struct msghdr *msg)
+{
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(msg); c; c = CMSG_NXTHDR(msg, c)) {
+        if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMPNS)
+            continue;
+        struct timespec ts, now;
+        memcpy(&ts, CMSG_DATA(c), sizeof ts);
+        clock_gettime(CLOCK_REALTIME, &now);
+        long long d = (long long)(now.tv_sec - ts.tv_sec) * 1000000000LL + (now.tv_nsec - ts.tv_nsec);
+        return d > 0 ? (co_time)d : 0;
+    }
+    return 0;
+}
+
+int co_can_recv(int fd, co_frame *f, co_time *age)
 {
     struct can_frame cf;
+    union {                     /* aligned room for the timestamp's cmsg */
+        char buf[CMSG_SPACE(sizeof(struct timespec))];
+        struct cmsghdr align;
+    } ctl;
     for (;;) {
-        ssize_t r = read(fd, &cf, sizeof cf);
+        struct iovec iov = { &cf, sizeof cf };
+        struct msghdr msg = { .msg_iov = &iov, .msg_iovlen = 1,
+                              .msg_control = ctl.buf, .msg_controllen = sizeof ctl.buf };
+        ssize_t r = recvmsg(fd, &msg, 0);
         if (r < 0)
             return (errno == EAGAIN || errno == EWOULDBLOCK) ? 0 : -1;
         if (r != (ssize_t)sizeof cf || (cf.can_id & CAN_EFF_FLAG && !(cf.can_id & CAN_ERR_FLAG)))
@@ -115,6 +141,8 @@ int co_can_recv(int fd, co_frame *f)
             f->id = cf.can_id & CAN_SFF_MASK;
             f->rtr = !!(cf.can_id & CAN_RTR_FLAG);
         }
+        if (age)
+            *age = frame_age(&msg);
         return 1;
     }
 }

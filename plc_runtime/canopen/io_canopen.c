@@ -64,6 +64,7 @@ typedef struct st {
     co_frame pending;
     int have_pending;
     co_master m;
+    co_time last_poll;      /* when poll_bus last read the bus */
     /* log queue: scan thread -> logging thread */
     pthread_mutex_t lock;
     pthread_t logger;
@@ -455,10 +456,14 @@ static void flush(st *s)
 static void poll_bus(st *s)
 {
     co_frame f;
-    co_time now = mono();
+    co_time now = mono(), age;
     int r;
-    while ((r = co_can_recv(s->fd, &f)) == 1)
-        co_master_rx(&s->m, &f, now);
+    /* each frame at the time it arrived (a guarding answer, a heartbeat,
+     * an SDO reply count from then, not from this scan), but not before
+     * the last look at the bus: a wall clock stepped forward must not
+     * date a frame into the past */
+    while ((r = co_can_recv(s->fd, &f, &age)) == 1)
+        co_master_rx(&s->m, &f, age < now - s->last_poll ? now - age : s->last_poll);
     if (r < 0 || s->link_down) {
         int up = co_can_link_up(s->fd, s->ifname);
         if (up != 1 && !s->link_down) {
@@ -470,6 +475,7 @@ static void poll_bus(st *s)
         }
     }
     co_master_tick(&s->m, now);
+    s->last_poll = now;
 }
 
 static void loc_text(const plc_loc *l, char *out, size_t n)

@@ -112,7 +112,7 @@ int main(int argc, char **argv)
             next = now;
         }
         int r;
-        while ((r = co_can_recv(fd, &f)) == 1)
+        while ((r = co_can_recv(fd, &f, NULL)) == 1)
             co_master_rx(&m, &f, now);
         if (r < 0)
             co_master_bus(&m, co_can_link_up(fd, ifname) == 1 ? CO_BUS_OK : CO_BUS_DOWN, strerror(errno));

@@ -6,7 +6,7 @@ analog output 1 of CiA 401 node 4 (slave401.Slave401, DRIVETYPE 91): the
 encoder sits on the shaft of the motor that output drives.  Both nodes are
 guarded.  The encoder starts 6000 counts below 2^31 and a POSA carries it
 across; then it stops answering guarding during a move: error 88 and the
-reference 0 on the bus within guard time x life factor / cycle + 4 RPDOs
+reference 0 on the bus within guard time x life factor / cycle + 2 RPDOs
 of its last answer (the recorded frames, with their kernel timestamps
 reported); ERRCLR while it is silent
 raises 88 again; a negative ENCODERTYPE lets ERRCLR stand; a wrong id is
@@ -256,15 +256,13 @@ if t_last is None:
     report("reference_zero_past_life_time", False, "no guarding answer of the encoder recorded")
 else:
     # bounded in the PLC's own cycles (one RPDO each), so that a stalled
-    # plcrt (it reports its overruns) cannot fail it: the answer is taken at
-    # the next cycle's start, the loss seen in the first cycle past the life
-    # time from there, APOSSAXIS opens the loop in that call and its DAC is 0
-    # from the next: the (life time / cycle + 2)th or, by the scan's jitter,
-    # the next RPDO after the last answer is 0, one later still if the cycle
-    # that took the answer woke late (the life time counts from its start);
-    # so every RPDO from the (+ 4)th on (the master itself zeroes only the
-    # lost node's RPDOs, and the encoder has none)
-    limit = round(GUARD * LIFE / CYCLE) + 4
+    # plcrt (it reports its overruns) cannot fail it: the master dates the
+    # answer by its kernel receive time and sees the loss in the first
+    # cycle that starts more than the life time after it; APOSSAXIS opens
+    # the loop in that call and its DAC is 0 in it: the (life time / cycle
+    # + 1)th RPDO after the last answer is 0, or by the scan's jitter the
+    # next: the seed's "guard time x life factor + one TIMER" in cycles
+    limit = round(GUARD * LIFE / CYCLE) + 2
     nxt = min([a for a in answers if a > t_last], default=float("inf"))
     after = [(t, d) for t, d in rpdo if t_last < t < nxt]
     moving = [t for t, d in rpdo if t_last - 0.2 < t < t_last and int.from_bytes(d[:2], "little", signed=True)]
@@ -275,7 +273,7 @@ else:
     ms0 = (after[first0 - 1][0] - t_last) * 1000 if first0 else 0
     report("reference_zero_past_life_time", len(after) > limit and not bad and moving and running,
            (f"the reference 0 from the {first0}th RPDO after the encoder's last answer, {ms0:.0f} ms after it (limit: the "
-            f"{limit}th, guard {GUARD * 1000:.0f} ms x life {LIFE} / cycle {CYCLE * 1000:.0f} ms + 4); "
+            f"{limit}th, guard {GUARD * 1000:.0f} ms x life {LIFE} / cycle {CYCLE * 1000:.0f} ms + 2); "
             + (f"non-zero at RPDOs {bad[:5]}" if bad else f"{len(after) - limit + 1} RPDOs from the limit on, all 0")
             + f"; {len(moving)} non-zero in the 200 ms before, silenced {(t_silent - t_last) * 1000:.0f} ms "
             f"after that answer")
