@@ -184,8 +184,6 @@ def main():
         if f.startswith(("aposs-", "onset-", "std-")):
             os.remove(os.path.join(work, f))
     port, port2 = free_port(), free_port()
-    while port2 == port:
-        port2 = free_port()
     cfg = exlib.example_ini(ini, os.path.join(work, "tune.ini"), port, "")
     cfg2 = exlib.example_ini(ini, os.path.join(work, "tune2.ini"), port2, "")
     work2 = os.path.join(work, "second")
