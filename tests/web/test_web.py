@@ -318,7 +318,9 @@ def login(drv, wport, user, pw, page="/overview"):
     drv.find_element(By.ID, "user").send_keys(user)
     drv.find_element(By.ID, "password").send_keys(pw)
     drv.find_element(By.ID, "login-button").click()
-    return wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 20, 0.05)
+    # the page after the form (chromium on a loaded host may take long)
+    return wait_for(lambda: "/login" not in drv.current_url
+                    and drv.execute_script("return document.body.dataset.ready") == "1", 60, 0.05)
 
 
 def text(drv, eid):
@@ -632,7 +634,7 @@ def tags_and_backends(drv, plcrt, ini_src, users, work, shots):
         login(drv, wport, "olga", "olga-secret-1", "/variables")
         drv.execute_script("localStorage.setItem('plcweb.watch', JSON.stringify(arguments[0]))",
                            [{"path": "CONFIG0.RES0.AXIS.SLVELASSE", "type": "DINT"}])
-        drv.refresh()
+        drv.get(f"http://127.0.0.1:{wport}/variables")     # the page again, with that watch list
         wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 30, 0.05)
         # the watch row appears once the page has the watch list's first values: poll for it
         rows = wait_for(lambda: drv.find_elements(By.ID, "w-CONFIG0_RES0_AXIS_SLVELASSE"), 30, 0.05)
