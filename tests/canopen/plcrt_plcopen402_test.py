@@ -86,7 +86,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from drive402 import Drive402  # noqa: E402
 from slave401 import CanDump, connect  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
-from peer import Report, wait_for  # noqa: E402
+from peer import Report, free_port, wait_for  # noqa: E402
 from onecycle import Recording  # noqa: E402
 from pymodbus.client import ModbusTcpClient  # noqa: E402
 
@@ -94,8 +94,8 @@ if sys.argv[1] == "--sim":                  # the sim-plant run, on the host
     plcrt, sim_plcrt, out = None, sys.argv[2], sys.argv[3]
 else:                                       # the bus run, in the kernel with CAN
     plcrt, out, sim_plcrt = sys.argv[1], sys.argv[2], None
-PORT = 15036
-SIM_PORT = 15037
+PORT = 15036                                # inside the kernel with CAN: its own network
+SIM_PORT = free_port() if sim_plcrt else 0  # on the host: a free one
 HERE = os.path.dirname(os.path.abspath(__file__))
 report = Report("canopen_plcopen402")
 RESET = 7                                   # coil of MC_Reset (both axes)
