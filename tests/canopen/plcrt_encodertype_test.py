@@ -24,7 +24,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from apossmb import AxisMb  # noqa: E402
-from slave401 import CanDump, Slave401, connect  # noqa: E402
+from slave401 import CanDump, Slave401, connect, reference_zero_after  # noqa: E402
 from enc406 import Encoder406  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 from peer import Report, wait_for  # noqa: E402
@@ -255,28 +255,9 @@ t_last = max([a for a in answers if a < t_silent], default=None)
 if t_last is None:
     report("reference_zero_past_life_time", False, "no guarding answer of the encoder recorded")
 else:
-    # bounded in the PLC's own cycles (one RPDO each), so that a stalled
-    # plcrt (it reports its overruns) cannot fail it: the master dates the
-    # answer by its kernel receive time and sees the loss in the first
-    # cycle that starts more than the life time after it; APOSSAXIS opens
-    # the loop in that call and its DAC is 0 in it: the (life time / cycle
-    # + 1)th RPDO after the last answer is 0, or by the scan's jitter the
-    # next: the seed's "guard time x life factor + one TIMER" in cycles
-    limit = round(GUARD * LIFE / CYCLE) + 2
     nxt = min([a for a in answers if a > t_last], default=float("inf"))
-    after = [(t, d) for t, d in rpdo if t_last < t < nxt]
-    moving = [t for t, d in rpdo if t_last - 0.2 < t < t_last and int.from_bytes(d[:2], "little", signed=True)]
-    bad = [k + 1 for k, (t, d) in enumerate(after) if k + 1 >= limit and any(d)]
-    # the first of the zeros that last until the node answers again
-    first0 = max([k + 2 for k, (t, d) in enumerate(after) if any(d)], default=1)
-    first0 = first0 if first0 <= len(after) else None
-    ms0 = (after[first0 - 1][0] - t_last) * 1000 if first0 else 0
-    report("reference_zero_past_life_time", len(after) > limit and not bad and moving and running,
-           (f"the reference 0 from the {first0}th RPDO after the encoder's last answer, {ms0:.0f} ms after it (limit: the "
-            f"{limit}th, guard {GUARD * 1000:.0f} ms x life {LIFE} / cycle {CYCLE * 1000:.0f} ms + 2); "
-            + (f"non-zero at RPDOs {bad[:5]}" if bad else f"{len(after) - limit + 1} RPDOs from the limit on, all 0")
-            + f"; {len(moving)} non-zero in the 200 ms before, silenced {(t_silent - t_last) * 1000:.0f} ms "
-            f"after that answer")
-           if first0 else "no zero RPDO")
+    ok, why = reference_zero_after(rpdo, t_last, nxt, GUARD * LIFE, CYCLE)
+    report("reference_zero_past_life_time", ok and running,
+           why + f"; silenced {(t_silent - t_last) * 1000:.0f} ms after that answer")
 trace.close(keep=not report.all_passed())
 sys.exit(0 if report.all_passed() else 1)

@@ -272,6 +272,30 @@ def connect(channel="vcan0"):
     return net
 
 
+def reference_zero_after(rpdo, t_last, t_next, life_s, cycle_s):
+    """Seed 000's reaction to a lost node, counted on the recorded reference
+    RPDOs (rpdo: [(kernel time, data)]) between the node's last good
+    guarding answer t_last and its next t_next: the master dates that answer
+    by its arrival and sees the loss in the first cycle that starts more
+    than the life time later, and APOSSAXIS puts out 0 in that very call; so
+    the (life / cycle + 1)th RPDO after the answer is 0, or by the scan's
+    jitter the next: counted in the PLC's cycles (one RPDO each), a stalled
+    plcrt cannot fail it.  Returns (ok, text) for the report."""
+    limit = round(life_s / cycle_s) + 2
+    after = [(t, d) for t, d in rpdo if t_last < t < t_next]
+    moving = [t for t, d in rpdo if t_last - 0.2 < t < t_last and int.from_bytes(d[:2], "little", signed=True)]
+    bad = [k + 1 for k, (t, d) in enumerate(after) if k + 1 >= limit and any(d)]
+    first0 = max([k + 2 for k, (t, d) in enumerate(after) if any(d)], default=1)
+    if first0 > len(after):
+        return False, "no zero RPDO"
+    ms0 = (after[first0 - 1][0] - t_last) * 1000
+    return (len(after) > limit and not bad and bool(moving),
+            f"the reference 0 from the {first0}th RPDO after the last answer, {ms0:.0f} ms after it (limit: "
+            f"the {limit}th, life time {life_s * 1000:.0f} ms / cycle {cycle_s * 1000:.0f} ms + 2); "
+            + (f"non-zero at RPDOs {bad[:5]}" if bad else f"{len(after) - limit + 1} RPDOs from the limit on, all 0")
+            + f"; {len(moving)} non-zero in the 200 ms before")
+
+
 class CanDump:
     """candump -L of the bus into path while the test runs; stop() ends the
     recording, frames(cob_id) reads it back with the kernel's timestamps,
