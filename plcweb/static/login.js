@@ -11,3 +11,4 @@ document.getElementById("login-form").addEventListener("submit", async (ev) => {
     document.getElementById("login-error").textContent = (await r.json()).error;
   }
 });
+document.getElementById("login-button").disabled = false;

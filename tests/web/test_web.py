@@ -315,6 +315,9 @@ def login(drv, wport, user, pw, page="/overview"):
     drv.delete_all_cookies()
     drv.get(f"http://127.0.0.1:{wport}{page}")
     wait_for(lambda: "/login" in drv.current_url, 30, 0.05)
+    # the form takes a click once its script handles it (the button is on)
+    wait_for(lambda: drv.execute_script(
+        "const b = document.getElementById('login-button'); return !!b && !b.disabled"), 60, 0.05)
     drv.find_element(By.ID, "user").send_keys(user)
     drv.find_element(By.ID, "password").send_keys(pw)
     drv.find_element(By.ID, "login-button").click()
