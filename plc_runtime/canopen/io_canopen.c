@@ -43,6 +43,7 @@ typedef struct nodecfg_ex {
     int guard_given;        /* guard_time_ms was set */
     int drivetype;          /* seed 000 DRIVETYPE +-91..94 of an APOSS axis on this node, or 0 */
     long encodertype;       /* seed 000 ENCODERTYPE of an APOSS axis whose encoder is this node, or 0 */
+    int enc_dev, enc_id;    /* its device type (50: CiA 406) and node id */
     char enc_text[24];      /* as written, for messages */
     char eds[256];          /* the node's EDS/DCF file, or "" */
     plc_loc status, ok;
@@ -325,6 +326,8 @@ static int config(void *vs, const char *section, const char *key, const char *v,
             return -1;
         }
         ex->encodertype = d;
+        ex->enc_dev = (int)dev;
+        ex->enc_id = (int)id;
         snprintf(ex->enc_text, sizeof ex->enc_text, "%ld", d);
         return 0;
     }
@@ -575,14 +578,13 @@ static int encoder_node(st *s, int i, char *err, size_t n)
 {
     co_node_cfg *c = &s->nodes[i].cfg;
     nodecfg_ex *ex = &s->ex[i];
-    long a = labs(ex->encodertype) % 100000;
-    if (a % 1000 != c->id) {
-        snprintf(err, n, "[%s] encodertype %s names node %ld, but the section's id is %u: write "
-                 "encodertype = %ld", ex->name, ex->enc_text, a % 1000, c->id,
-                 (ex->encodertype < 0 ? -1 : 1) * (labs(ex->encodertype) - a % 1000 + c->id));
+    if (ex->enc_id != c->id) {
+        snprintf(err, n, "[%s] encodertype %s names node %d, but the section's id is %u: write "
+                 "encodertype = %ld", ex->name, ex->enc_text, ex->enc_id, c->id,
+                 (ex->encodertype < 0 ? -1 : 1) * (labs(ex->encodertype) - ex->enc_id + c->id));
         return -1;
     }
-    if (a / 1000 == 50 && !ex->pdo_given && !ex->eds[0]) {
+    if (ex->enc_dev == 50 && !ex->pdo_given && !ex->eds[0]) {
         memset(c->rpdo, 0, sizeof c->rpdo);
         memset(c->tpdo, 0, sizeof c->tpdo);
         for (unsigned k = 0; k < CO_PDO_PER_NODE; k++)
@@ -598,7 +600,7 @@ static int encoder_node(st *s, int i, char *err, size_t n)
 static int encoder_bound(st *s, int i, char *err, size_t n)
 {
     nodecfg_ex *ex = &s->ex[i];
-    int enc406 = labs(ex->encodertype) % 100000 / 1000 == 50;
+    int enc406 = ex->enc_dev == 50;
     for (int k = 0; k < s->nbinds; k++) {
         const bind *b = &s->binds[k];
         if (b->node != i || !b->tx || b->bit >= 0 || b->bits != 32)
