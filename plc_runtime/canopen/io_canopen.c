@@ -9,6 +9,7 @@
  * small logging thread (the scan never waits on it longer than a copy). */
 #include <errno.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,11 +67,12 @@ typedef struct st {
     int have_pending;
     co_master m;
     co_time last_poll;      /* when poll_bus last read the bus */
-    /* log queue: scan thread -> logging thread */
-    pthread_mutex_t lock;
+    /* log queue: one producer (the scan thread) and one consumer (the
+       logging thread), lock-free: the scan never waits for the logger */
     pthread_t logger;
-    int logger_on, quit;
-    unsigned lq_head, lq_tail, lq_lost;
+    int logger_on;
+    atomic_int quit;
+    atomic_uint lq_head, lq_tail, lq_lost;
     struct { int err; char msg[200]; } lq[LOGQ];
     int direct_log;         /* main thread phases: print at once */
 } st;
@@ -89,34 +91,30 @@ static void logcb(void *ctx, int err, const char *msg)
         plc_log(err ? LOG_ERROR : LOG_INFO, "canopen: %s", msg);
         return;
     }
-    pthread_mutex_lock(&s->lock);
-    if (s->lq_tail - s->lq_head < LOGQ) {
-        unsigned i = s->lq_tail++ % LOGQ;
-        s->lq[i].err = err;
-        snprintf(s->lq[i].msg, sizeof s->lq[i].msg, "%s", msg);
-    } else
-        s->lq_lost++;
-    pthread_mutex_unlock(&s->lock);
+    unsigned t = atomic_load_explicit(&s->lq_tail, memory_order_relaxed);
+    if (t - atomic_load_explicit(&s->lq_head, memory_order_acquire) >= LOGQ) {
+        atomic_fetch_add_explicit(&s->lq_lost, 1, memory_order_relaxed);
+        return;
+    }
+    s->lq[t % LOGQ].err = err;
+    snprintf(s->lq[t % LOGQ].msg, sizeof s->lq[t % LOGQ].msg, "%s", msg);
+    atomic_store_explicit(&s->lq_tail, t + 1, memory_order_release);    /* the slot is written */
 }
 
 static void *logger(void *arg)
 {
     st *s = arg;
     for (;;) {
-        int err = 0, have = 0, quit;
-        unsigned lost = 0;
+        int err = 0, have = 0, quit = atomic_load(&s->quit);
         char msg[200];
-        pthread_mutex_lock(&s->lock);
-        if (s->lq_head != s->lq_tail) {
-            unsigned i = s->lq_head++ % LOGQ;
-            err = s->lq[i].err;
-            memcpy(msg, s->lq[i].msg, sizeof msg);
+        unsigned h = atomic_load_explicit(&s->lq_head, memory_order_relaxed);
+        if (h != atomic_load_explicit(&s->lq_tail, memory_order_acquire)) {
+            err = s->lq[h % LOGQ].err;
+            memcpy(msg, s->lq[h % LOGQ].msg, sizeof msg);
+            atomic_store_explicit(&s->lq_head, h + 1, memory_order_release);  /* the slot is free */
             have = 1;
         }
-        lost = s->lq_lost;
-        s->lq_lost = 0;
-        quit = s->quit;
-        pthread_mutex_unlock(&s->lock);
+        unsigned lost = atomic_exchange_explicit(&s->lq_lost, 0, memory_order_relaxed);
         if (have)
             plc_log(err ? LOG_ERROR : LOG_INFO, "canopen: %s", msg);
         if (lost)
@@ -140,7 +138,6 @@ static void *create(void)
     s->sdo_ms = 500;
     s->wait_ms = 5000;
     s->fd = -1;
-    pthread_mutex_init(&s->lock, NULL);
     return s;
 }
 
@@ -796,14 +793,11 @@ static void close_(void *vs)
 {
     st *s = vs;
     if (s->logger_on) {
-        pthread_mutex_lock(&s->lock);
-        s->quit = 1;
-        pthread_mutex_unlock(&s->lock);
+        atomic_store(&s->quit, 1);
         pthread_join(s->logger, NULL);
     }
     if (s->fd >= 0)
         close(s->fd);
-    pthread_mutex_destroy(&s->lock);
     free(s);
 }
 
