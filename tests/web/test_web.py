@@ -312,9 +312,13 @@ def security(wport, mb, work):
 
 
 def login(drv, wport, user, pw, page="/overview"):
-    drv.delete_all_cookies()
+    # the page before goes first: still polling its plcweb, it would meet
+    # the cookies' removal with its own way to a log-in page, which can
+    # overtake the navigation below (another plcweb's log-in, logged in)
+    drv.get("about:blank")
+    drv.execute_cdp_cmd("Network.clearBrowserCookies", {})
     drv.get(f"http://127.0.0.1:{wport}{page}")
-    wait_for(lambda: "/login" in drv.current_url, 30, 0.05)
+    wait_for(lambda: f"127.0.0.1:{wport}/login" in drv.current_url, 30, 0.05)
     # the form takes a click once its script handles it (the button is on)
     wait_for(lambda: drv.execute_script(
         "const b = document.getElementById('login-button'); return !!b && !b.disabled"), 60, 0.05)
@@ -322,8 +326,18 @@ def login(drv, wport, user, pw, page="/overview"):
     drv.find_element(By.ID, "password").send_keys(pw)
     drv.find_element(By.ID, "login-button").click()
     # the page after the form (chromium on a loaded host may take long)
-    return wait_for(lambda: "/login" not in drv.current_url
+    return wait_for(lambda: f"127.0.0.1:{wport}/" in drv.current_url and "/login" not in drv.current_url
                     and drv.execute_script("return document.body.dataset.ready") == "1", 60, 0.05)
+
+
+def page_state(drv):
+    """Where the browser is, for a failure's message."""
+    try:
+        return str(drv.execute_script(
+            "return {url: location.href, ready: document.body.dataset.ready || null,"
+            " watch: localStorage.getItem('plcweb.watch'), text: document.body.innerText.slice(0, 300)}"))
+    except Exception as e:
+        return f"{drv.current_url} ({e})"
 
 
 def text(drv, eid):
@@ -634,14 +648,18 @@ def tags_and_backends(drv, plcrt, ini_src, users, work, shots):
         wait_for(lambda: socket.socket().connect_ex(("127.0.0.1", wport)) == 0, 15, 0.1)
         wait_for(lambda: mb.coil(C_LOOPON), 20, 0.05)
         # ---- a parameter written with forcing off ----
-        login(drv, wport, "olga", "olga-secret-1", "/variables")
+        logged = login(drv, wport, "olga", "olga-secret-1", "/variables")
         drv.execute_script("localStorage.setItem('plcweb.watch', JSON.stringify(arguments[0]))",
                            [{"path": "CONFIG0.RES0.AXIS.SLVELASSE", "type": "DINT"}])
         drv.get(f"http://127.0.0.1:{wport}/variables")     # the page again, with that watch list
         wait_for(lambda: drv.execute_script("return document.body.dataset.ready") == "1", 30, 0.05)
-        # the watch row appears once the page has the watch list's first values: poll for it
         rows = wait_for(lambda: drv.find_elements(By.ID, "w-CONFIG0_RES0_AXIS_SLVELASSE"), 30, 0.05)
-        row = rows[0] if rows else drv.find_element(By.ID, "w-CONFIG0_RES0_AXIS_SLVELASSE")
+        if not rows:
+            drv.save_screenshot(os.path.join(shots, "web-tags-watch.png"))
+            report("forcing off: the watch list's row for slVelAsse on the variables page", False,
+                   f"log-in {bool(logged)}, {page_state(drv)}")
+            return
+        row = rows[0]
         row.find_element(By.CSS_SELECTOR, "input").send_keys("41")
         row.find_element(By.CSS_SELECTOR, "button.write").click()
         said = wait_for(lambda: "Modbus write" in text(drv, "message") and text(drv, "message"), 30, 0.05)
