@@ -5,8 +5,8 @@
  * Scan thread: read_inputs drains the socket, advances time-outs and copies
  * the TPDO data received since the last cycle into the %I areas;
  * write_outputs packs the %Q areas into RPDOs and sends them, then SYNC.
- * Messages the master produces in the scan are queued and printed by a
- * small logging thread (the scan never waits on it longer than a copy). */
+ * Messages the master produces in the scan go through a lock-free queue
+ * to a small logging thread that prints them: the scan never waits on it. */
 #include <errno.h>
 #include <pthread.h>
 #include <stdatomic.h>
